@@ -1,0 +1,264 @@
+"""The occupancy grid every planner reads.
+
+Convention (the one of ROS ``nav_msgs/OccupancyGrid``)::
+
+    y ^
+      |  row H-1  +---+---+---+
+      |     ...   |   |   |   |
+      |  row 1    +---+---+---+
+      |  row 0    | . | # | . |      occupied[row, col]
+      |           +---+---+---+
+      |         origin
+      +-----------------------------> x
+                  col 0  1   2
+
+* ``occupied[row, col]`` is a boolean array; row 0 is the *bottom* row.
+* Column index grows with x, row index with y.
+* ``origin`` (metres) is the lower-left corner of cell (0, 0); ``resolution``
+  is the side of a cell in metres.  The centre of cell (r, c) is
+  ``origin + ((c + 0.5) * resolution, (r + 0.5) * resolution)``.
+
+MovingAI maps and images are stored top row first; their readers flip them so
+that this convention holds for every map in pathfuse.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from scipy import ndimage
+
+from pathfuse.result import MapError
+
+__all__ = ["GridMap"]
+
+
+def _as_points(xy: object, what: str = "point") -> np.ndarray:
+    """(2,) or (N, 2) array-like -> float (N, 2); raises MapError on bad shape."""
+    p = np.asarray(xy, dtype=np.float64)
+    if p.ndim == 1:
+        p = p.reshape(1, -1)
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise MapError(f"{what} must have shape (2,) or (N, 2), got {np.shape(xy)}")
+    return p
+
+
+@dataclass(frozen=True, eq=False)
+class GridMap:
+    """A 2-D occupancy grid with a metric frame.
+
+    Parameters
+    ----------
+    occupied : array_like of bool, shape (H, W)
+        ``True`` where a cell is blocked.  Row 0 is the bottom row.
+    resolution : float
+        Cell side in metres (> 0).
+    origin : (float, float)
+        World coordinates (metres) of the lower-left corner of cell (0, 0).
+    name : str
+        A label used in reports and figures.
+
+    Examples
+    --------
+    >>> g = GridMap.from_rows(["..#", "...", "#.."], resolution=0.5)
+    >>> g.shape
+    (3, 3)
+    >>> bool(g.occupied[0, 0])  # the bottom-left cell is the last text row
+    True
+    >>> g.cell_to_world([[0, 1]]).tolist()
+    [[0.75, 0.25]]
+    >>> g.world_to_cell([0.75, 0.25]).tolist()
+    [[0, 1]]
+    """
+
+    occupied: np.ndarray
+    resolution: float = 1.0
+    origin: tuple[float, float] = (0.0, 0.0)
+    name: str = "grid"
+    meta: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        occ = np.asarray(self.occupied)
+        if occ.ndim != 2:
+            raise MapError(f"occupancy must be a 2-D array, got shape {occ.shape}")
+        if occ.size == 0:
+            raise MapError(f"map {self.name!r} is empty (shape {occ.shape})")
+        if occ.dtype != np.bool_:
+            if not np.issubdtype(occ.dtype, np.number):
+                raise MapError(f"occupancy must be boolean or numeric, got dtype {occ.dtype}")
+            occ = occ != 0
+        occ = np.ascontiguousarray(occ, dtype=np.bool_).copy()
+        occ.setflags(write=False)
+        object.__setattr__(self, "occupied", occ)
+        try:
+            res = float(self.resolution)
+        except (TypeError, ValueError):
+            raise MapError(f"resolution must be a number, got {self.resolution!r}") from None
+        if not np.isfinite(res) or res <= 0:
+            raise MapError(f"resolution must be a finite number > 0, got {self.resolution!r}")
+        object.__setattr__(self, "resolution", res)
+        try:
+            ox, oy = (float(v) for v in self.origin)
+        except (TypeError, ValueError):
+            raise MapError(f"origin must be two numbers (x, y), got {self.origin!r}") from None
+        if not (np.isfinite(ox) and np.isfinite(oy)):
+            raise MapError(f"origin must be finite, got {self.origin!r}")
+        object.__setattr__(self, "origin", (ox, oy))
+
+    # ------------------------------------------------------------------ builders
+    @classmethod
+    def from_rows(
+        cls,
+        rows: list[str],
+        resolution: float = 1.0,
+        origin: tuple[float, float] = (0.0, 0.0),
+        name: str = "rows",
+        blocked: str = "#@",
+    ) -> GridMap:
+        """Build a map from text rows, the *first* row being the *top* of the map.
+
+        ``blocked`` characters are obstacles, every other character is free.
+        """
+        if not rows:
+            raise MapError("rows must hold at least one row")
+        widths = {len(r) for r in rows}
+        if len(widths) != 1:
+            raise MapError(f"rows must all have the same length, got lengths {sorted(widths)}")
+        arr = np.array([[ch in blocked for ch in r] for r in rows], dtype=bool)
+        return cls(arr[::-1], resolution=resolution, origin=origin, name=name)
+
+    def with_occupied(self, occupied: np.ndarray, name: str | None = None) -> GridMap:
+        """A copy with another occupancy array of the same shape and frame."""
+        occupied = np.asarray(occupied, dtype=bool)
+        if occupied.shape != self.shape:
+            raise MapError(f"occupancy shape {occupied.shape} != map shape {self.shape}")
+        return GridMap(occupied, self.resolution, self.origin, name or self.name, dict(self.meta))
+
+    # ------------------------------------------------------------------ geometry
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(rows, cols) = (height, width) in cells."""
+        return self.occupied.shape  # type: ignore[return-value]
+
+    @property
+    def height(self) -> int:
+        return int(self.occupied.shape[0])
+
+    @property
+    def width(self) -> int:
+        return int(self.occupied.shape[1])
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(x_min, y_min, x_max, y_max) of the map in metres."""
+        ox, oy = self.origin
+        return (ox, oy, ox + self.width * self.resolution, oy + self.height * self.resolution)
+
+    @property
+    def free_count(self) -> int:
+        return int(self.occupied.size - np.count_nonzero(self.occupied))
+
+    def world_to_cell(self, xy: object) -> np.ndarray:
+        """(N, 2) int array of ``[row, col]`` for world points ``[x, y]``.
+
+        Points outside the map give indices outside ``[0, H) x [0, W)``; use
+        :meth:`in_bounds` to test.  Non-finite points raise :class:`MapError`.
+        """
+        p = _as_points(xy)
+        if not np.all(np.isfinite(p)):
+            raise MapError(f"coordinates must be finite, got {p[~np.isfinite(p).all(1)][0].tolist()}")
+        col = np.floor((p[:, 0] - self.origin[0]) / self.resolution).astype(np.int64)
+        row = np.floor((p[:, 1] - self.origin[1]) / self.resolution).astype(np.int64)
+        return np.stack([row, col], axis=1)
+
+    def cell_to_world(self, cells: object) -> np.ndarray:
+        """(N, 2) float array of cell-centre ``[x, y]`` for ``[row, col]`` cells."""
+        c = np.asarray(cells, dtype=np.float64)
+        if c.ndim == 1:
+            c = c.reshape(1, -1)
+        x = self.origin[0] + (c[:, 1] + 0.5) * self.resolution
+        y = self.origin[1] + (c[:, 0] + 0.5) * self.resolution
+        return np.stack([x, y], axis=1)
+
+    def cells_in_bounds(self, cells: object) -> np.ndarray:
+        c = np.asarray(cells).reshape(-1, 2)
+        return (c[:, 0] >= 0) & (c[:, 0] < self.height) & (c[:, 1] >= 0) & (c[:, 1] < self.width)
+
+    def in_bounds(self, xy: object) -> np.ndarray:
+        """Boolean array: which world points lie inside the map."""
+        p = _as_points(xy)
+        ok = np.isfinite(p).all(axis=1)
+        out = np.zeros(p.shape[0], dtype=bool)
+        if ok.any():
+            out[ok] = self.cells_in_bounds(self.world_to_cell(p[ok]))
+        return out
+
+    def is_free(self, xy: object) -> np.ndarray:
+        """Boolean array: which world points lie in a free cell (out of map -> False)."""
+        p = _as_points(xy)
+        out = self.in_bounds(p)
+        if out.any():
+            rc = self.world_to_cell(p[out])
+            out[out] = ~self.occupied[rc[:, 0], rc[:, 1]]
+        return out
+
+    # ------------------------------------------------------------------ derived maps
+    def inflate(self, radius_m: float) -> GridMap:
+        """Grow obstacles by a disc robot's radius.
+
+        A cell becomes occupied when its centre lies closer than ``radius_m``
+        to an occupied cell (the cell taken as a square, not as its centre),
+        so a disc of that radius centred on any free cell centre touches no
+        obstacle.  ``radius_m = 0`` returns an equal map.
+
+        >>> g = GridMap.from_rows([".....", ".....", "..#..", ".....", "....."])
+        >>> int(g.inflate(0.4).occupied.sum()), int(g.inflate(0.6).occupied.sum())
+        (1, 5)
+        """
+        r = float(radius_m)
+        if not np.isfinite(r) or r < 0:
+            raise MapError(f"inflation radius must be a finite number >= 0, got {radius_m!r}")
+        if r == 0 or not self.occupied.any():
+            return self.with_occupied(self.occupied.copy())
+        # distance from a cell centre to the nearest point of an occupied square
+        # = distance to the square's centre shrunk by half a cell on each axis.
+        k = int(np.ceil(r / self.resolution + 0.5))
+        d = np.arange(-k, k + 1, dtype=np.float64)
+        dx = np.maximum(np.abs(d)[None, :] - 0.5, 0.0)
+        dy = np.maximum(np.abs(d)[:, None] - 0.5, 0.0)
+        footprint = np.hypot(dx, dy) * self.resolution < r
+        grown = ndimage.binary_dilation(self.occupied, structure=footprint)
+        return self.with_occupied(grown | self.occupied, name=f"{self.name}+r{r:g}")
+
+    @cached_property
+    def distance_field(self) -> np.ndarray:
+        """Euclidean distance (metres) from each cell centre to the nearest occupied cell centre.
+
+        Occupied cells hold 0.  A map with no obstacle holds ``inf``
+        everywhere.  Computed once (scipy.ndimage.distance_transform_edt) and
+        cached.
+        """
+        if not self.occupied.any():
+            df = np.full(self.shape, np.inf)
+        else:
+            df = ndimage.distance_transform_edt(~self.occupied) * self.resolution
+        df.setflags(write=False)
+        return df
+
+    @cached_property
+    def components(self) -> np.ndarray:
+        """Label of the connected free region of each cell (0 for occupied).
+
+        4-connectivity, which equals 8-connectivity without corner cutting.
+        """
+        labels, _ = ndimage.label(~self.occupied)
+        labels.setflags(write=False)
+        return labels
+
+    def __repr__(self) -> str:
+        return (
+            f"GridMap(name={self.name!r}, shape={self.shape}, resolution={self.resolution:g}, "
+            f"origin={self.origin}, free={self.free_count})"
+        )

@@ -1,0 +1,191 @@
+"""Statuses, plan results, budgets and the exception classes shared by every planner.
+
+Every planner in pathfuse returns a :class:`PlanResult`; none raises on an
+ordinary planning failure (no path, local minimum, budget exhausted).  Bad
+*input* (a malformed file, a NaN coordinate, an unknown parameter) raises a
+subclass of :class:`PathfuseError` whose message names the file, key or value.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "Status",
+    "PlanResult",
+    "Budget",
+    "PathfuseError",
+    "MapError",
+    "MapFormatError",
+    "QueryError",
+    "ConfigError",
+    "PlanningFailed",
+]
+
+
+class PathfuseError(Exception):
+    """Base class of every error pathfuse raises on purpose."""
+
+
+class MapError(PathfuseError, ValueError):
+    """A map is unusable: empty, no free cell, bad resolution or origin."""
+
+
+class MapFormatError(MapError):
+    """A map or scenario file cannot be read; the message names the file and line."""
+
+
+class QueryError(PathfuseError, ValueError):
+    """A start or goal is not a finite (x, y) pair."""
+
+
+class ConfigError(PathfuseError, ValueError):
+    """An unknown planner, an unknown parameter, or a parameter out of range."""
+
+
+class PlanningFailed(PathfuseError):
+    """Raised by :meth:`PlanResult.raise_for_status` when a plan did not succeed."""
+
+    def __init__(self, result: PlanResult):
+        super().__init__(f"{result.planner}: {result.status.name}: {result.message}")
+        self.result = result
+
+
+class Status(enum.Enum):
+    """How a planning query ended.  Only ``SUCCESS`` carries a complete path."""
+
+    SUCCESS = "success"
+    NO_PATH = "no_path"
+    START_OCCUPIED = "start_occupied"
+    GOAL_OCCUPIED = "goal_occupied"
+    START_OUT_OF_BOUNDS = "start_out_of_bounds"
+    GOAL_OUT_OF_BOUNDS = "goal_out_of_bounds"
+    LOCAL_MINIMUM = "local_minimum"
+    MAX_ITERATIONS = "max_iterations"
+    TIMEOUT = "timeout"
+    COLLISION = "collision"
+
+    @property
+    def ok(self) -> bool:
+        return self is Status.SUCCESS
+
+
+@dataclass(frozen=True)
+class Budget:
+    """Limits that end every planning loop.
+
+    Attributes
+    ----------
+    max_iterations : int or None
+        Cap on expansions (A*) or steps (APF-style planners).  ``None`` means
+        the planner's own default, which is always finite.
+    time_limit_s : float or None
+        Wall-clock limit in seconds, checked between batches of work.
+    """
+
+    max_iterations: int | None = None
+    time_limit_s: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.max_iterations is not None and (
+            not isinstance(self.max_iterations, (int, np.integer)) or self.max_iterations < 1
+        ):
+            raise ConfigError(f"max_iterations must be a positive integer, got {self.max_iterations!r}")
+        if self.time_limit_s is not None and not (
+            isinstance(self.time_limit_s, (int, float)) and np.isfinite(self.time_limit_s)
+            and self.time_limit_s > 0
+        ):
+            raise ConfigError(f"time_limit_s must be a positive number, got {self.time_limit_s!r}")
+
+
+def _empty_path() -> np.ndarray:
+    return np.zeros((0, 2), dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """The outcome of one planning query.
+
+    Attributes
+    ----------
+    status : Status
+        How the query ended.
+    path : ndarray, shape (N, 2)
+        Waypoints in world coordinates (metres).  On ``SUCCESS`` the first
+        point is the start and the last the goal (cell centres for grid
+        planners); on failure it is the partial path a local planner walked,
+        or empty ``(0, 2)`` for a grid search.
+    length : float
+        Length of ``path`` in metres (sum of segment lengths).
+    time_s : float
+        Wall-clock planning time in seconds (numba compilation excluded: the
+        kernels are compiled and cached before timing starts).
+    planner : str
+        Registry name of the planner.
+    expansions : int
+        Nodes expanded by grid search (0 if none ran).
+    iterations : int
+        Steps taken by a local planner (0 if none ran).
+    message : str
+        A human sentence about the outcome.
+    info : dict
+        Planner-specific extras (for example the A* global path of fusion).
+    """
+
+    status: Status
+    path: np.ndarray = field(default_factory=_empty_path)
+    length: float = 0.0
+    time_s: float = 0.0
+    planner: str = ""
+    expansions: int = 0
+    iterations: int = 0
+    message: str = ""
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def __bool__(self) -> bool:
+        return self.status is Status.SUCCESS
+
+    @property
+    def success(self) -> bool:
+        return self.status is Status.SUCCESS
+
+    def raise_for_status(self) -> PlanResult:
+        """Return ``self`` on success, else raise :class:`PlanningFailed`.
+
+        Examples
+        --------
+        >>> PlanResult(Status.SUCCESS).raise_for_status().status
+        <Status.SUCCESS: 'success'>
+        """
+        if self.status is not Status.SUCCESS:
+            raise PlanningFailed(self)
+        return self
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict (path as a list of ``[x, y]``)."""
+        return {
+            "planner": self.planner,
+            "status": self.status.name,
+            "length": float(self.length),
+            "time_s": float(self.time_s),
+            "expansions": int(self.expansions),
+            "iterations": int(self.iterations),
+            "message": self.message,
+            "path": np.asarray(self.path, dtype=float).tolist(),
+        }
+
+
+def path_length(path: np.ndarray) -> float:
+    """Sum of segment lengths of an (N, 2) path; 0 for fewer than two points.
+
+    >>> path_length(np.array([[0.0, 0.0], [3.0, 4.0], [3.0, 5.0]]))
+    6.0
+    """
+    p = np.asarray(path, dtype=np.float64)
+    if p.shape[0] < 2:
+        return 0.0
+    return float(np.hypot(*np.diff(p, axis=0).T).sum())

@@ -1,0 +1,304 @@
+"""The ``pathfuse`` command line.  Thin: parses arguments and calls the library.
+
+Every error a user can cause ends in one line on stderr and a non-zero exit
+status (2 for bad input, 1 for a failed check such as a scen mismatch or a
+plan that did not succeed), never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pathfuse.result import PathfuseError
+
+EXIT_FAIL = 1
+EXIT_USAGE = 2
+
+
+class CliError(PathfuseError):
+    """A bad command-line value (exit status 2)."""
+
+
+def _fmt(s: str) -> str:
+    return s.strip("\n")
+
+
+MAIN_EPILOG = _fmt("""
+examples:
+  pathfuse plan --map paper --seed 3 --plot plan.png
+  pathfuse plan --map den312d.map --start 10.5,70.5 --goal 60.5,8.5 --json
+  pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 500
+  pathfuse planners
+
+Run 'pathfuse COMMAND --help' for the options of a command.
+""")
+
+
+# --------------------------------------------------------------------------- parsing helpers
+def parse_point(text: str, what: str) -> tuple[float, float]:
+    """``"1.5,2"`` -> (1.5, 2.0); :class:`CliError` naming ``what`` otherwise."""
+    parts = [p.strip() for p in str(text).replace(";", ",").split(",")]
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        x, y = float(parts[0]), float(parts[1])
+    except ValueError:
+        raise CliError(f"{what}: expected X,Y (two numbers in metres), got {text!r}") from None
+    if not (np.isfinite(x) and np.isfinite(y)):
+        raise CliError(f"{what}: coordinates must be finite, got {text!r}")
+    return x, y
+
+
+def parse_params(items: Sequence[str] | None) -> dict[str, Any]:
+    """``["r1=1.5", "ahead=paper-x"]`` -> {"r1": 1.5, "ahead": "paper-x"} (YAML scalars)."""
+    import yaml
+
+    out: dict[str, Any] = {}
+    for item in items or []:
+        key, sep, val = item.partition("=")
+        if not sep or not key.strip():
+            raise CliError(f"--param: expected KEY=VALUE, got {item!r}")
+        try:
+            out[key.strip()] = yaml.safe_load(val)
+        except yaml.YAMLError:
+            raise CliError(f"--param {key}: cannot read value {val!r}") from None
+    return out
+
+
+def _positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return v
+
+
+def _float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not np.isfinite(v):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return v
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports errors in one line and exits with status 2."""
+
+    def error(self, message: str):  # type: ignore[override]
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+
+
+def _load_map(args: argparse.Namespace):
+    from pathfuse.io import load_map
+
+    return load_map(args.map, resolution=args.resolution, seed=args.seed)
+
+
+# --------------------------------------------------------------------------- commands
+def cmd_plan(args: argparse.Namespace) -> int:
+    import pathfuse
+    from pathfuse.generate import PAPER_GOAL, PAPER_START
+
+    grid = _load_map(args)
+    is_paper = str(args.map).lower() == "paper"
+    if args.start is None or args.goal is None:
+        if not is_paper:
+            raise CliError("--start and --goal are required unless --map paper")
+    start = parse_point(args.start, "--start") if args.start else PAPER_START
+    goal = parse_point(args.goal, "--goal") if args.goal else PAPER_GOAL
+    if args.robot_radius:
+        grid = grid.inflate(args.robot_radius)
+    params = parse_params(args.param)
+    budget = pathfuse.Budget(time_limit_s=args.time_limit) if args.time_limit else None
+    result = pathfuse.plan(grid, start, goal, planner=args.planner, budget=budget, **params)
+    if args.plot:
+        from pathfuse.viz import plot_plan
+
+        plot_plan(
+            grid, result, start, goal, args.plot,
+            title=f"{grid.name}: {args.planner} {result.status.name} {result.length:.3f} m",
+            astar_points=result.info.get("astar_path"),
+        )
+    if args.json:
+        d = result.to_dict()
+        d["map"] = grid.name
+        d["start"], d["goal"] = list(start), list(goal)
+        print(json.dumps(d))
+    else:
+        print(f"map       {grid.name}  ({grid.width} x {grid.height} cells, {grid.resolution:g} m)")
+        print(f"planner   {result.planner}")
+        print(f"status    {result.status.name}  {result.message}")
+        print(f"length    {result.length:.4f} m  ({len(result.path)} points)")
+        print(f"time      {result.time_s * 1e3:.3f} ms")
+        if result.expansions:
+            print(f"expanded  {result.expansions}")
+        if result.iterations:
+            print(f"steps     {result.iterations}")
+        if args.plot:
+            print(f"figure    {args.plot}")
+    return 0 if result.success else EXIT_FAIL
+
+
+def cmd_scen(args: argparse.Namespace) -> int:
+    import pathfuse
+    from pathfuse.io import read_movingai, read_scen
+
+    grid = read_movingai(args.map)
+    problems = read_scen(args.scen, grid)
+    if args.limit:
+        problems = problems[: args.limit]
+    n_ok = n_bad = 0
+    total_t = 0.0
+    worst: list[str] = []
+    for p in problems:
+        r = pathfuse.plan(grid, p.start, p.goal, planner="astar", heuristic=args.heuristic)
+        total_t += r.time_s
+        ok = r.success and abs(r.length - p.optimal_length) <= args.tol * max(1.0, p.optimal_length)
+        if ok:
+            n_ok += 1
+        else:
+            n_bad += 1
+            if len(worst) < 10:
+                worst.append(
+                    f"  line {p.line}: expected {p.optimal_length:.8f}, got "
+                    f"{r.length:.8f} ({r.status.name})"
+                )
+    n = n_ok + n_bad
+    print(f"{Path(args.scen).name}: {n_ok}/{n} lines match the optimal length "
+          f"(rel. tol {args.tol:g}); A* time {total_t:.3f} s, {1e3 * total_t / max(n, 1):.3f} ms/query")
+    for line in worst:
+        print(line)
+    return 0 if n_bad == 0 else EXIT_FAIL
+
+
+def cmd_planners(args: argparse.Namespace) -> int:
+    from pathfuse.planners.registry import REGISTRY, planner_names
+
+    names = planner_names()
+    if args.json:
+        print(json.dumps({n: {"description": REGISTRY[n].description,
+                              "defaults": REGISTRY[n].defaults()} for n in names}))
+        return 0
+    width = max(len(n) for n in names)
+    for n in names:
+        spec = REGISTRY[n]
+        print(f"{n:<{width}}  {spec.description}")
+        defaults = ", ".join(f"{k}={v!r}" for k, v in spec.defaults().items())
+        if defaults:
+            print(f"{'':<{width}}  defaults: {defaults}")
+    return 0
+
+
+# --------------------------------------------------------------------------- parser
+def build_parser() -> argparse.ArgumentParser:
+    from pathfuse import __version__
+
+    parser = _Parser(
+        prog="pathfuse",
+        description="2-D robot path planning: exact fast A*, artificial potential fields and "
+        "the A*-APF fusion planner of Ju, Luo and Yan.",
+        epilog=MAIN_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"pathfuse {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    p = sub.add_parser(
+        "plan",
+        help="plan one path on a map and print (or plot) the result",
+        description="Plan one path on a map.  Coordinates are world coordinates in metres "
+        "(ROS convention: origin = lower-left corner of cell (0, 0)).",
+        epilog=_fmt("""
+examples:
+  pathfuse plan --map paper --seed 3 --planner astar --plot plan.png
+  pathfuse plan --map maps/office.yaml --start 1.0,2.5 --goal 8.2,4.0 --robot-radius 0.2
+  pathfuse plan --map room.png --resolution 0.05 --start 1,1 --goal 5,4 --json
+  pathfuse plan --map paper --planner astar --param heuristic=octile
+
+--map accepts: 'paper' (the paper's random 15 m map, --seed N), a MovingAI .map,
+a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolution).
+"""),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--map", required=True, help="map file, or 'paper'")
+    p.add_argument("--start", help="start X,Y in metres (default for --map paper: 1,1)")
+    p.add_argument("--goal", help="goal X,Y in metres (default for --map paper: 11,11)")
+    p.add_argument("--planner", default="astar", help="planner name (see 'pathfuse planners')")
+    p.add_argument("--param", action="append", metavar="KEY=VALUE",
+                   help="planner parameter, repeatable (e.g. --param heuristic=octile)")
+    p.add_argument("--resolution", type=_float, help="metres per cell for image/.npy maps")
+    p.add_argument("--seed", type=int, default=0, help="seed of --map paper (default 0)")
+    p.add_argument("--robot-radius", type=_float, default=0.0,
+                   help="inflate obstacles by this disc radius in metres (default 0)")
+    p.add_argument("--time-limit", type=_float, help="planning time limit in seconds")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--plot", metavar="OUT.png", help="write a PNG figure of the plan")
+    p.set_defaults(func=cmd_plan)
+
+    s = sub.add_parser(
+        "scen",
+        help="check A* against a MovingAI scenario file's optimal lengths",
+        description="Run the lines of a MovingAI .scen file through A* (8-connected, sqrt(2) "
+        "diagonals, no corner cutting) and count how many match the file's optimal length.  "
+        "Exit status 1 on any mismatch.",
+        epilog=_fmt("""
+example:
+  pathfuse scen den312d.map den312d.map.scen
+  pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 1000 --heuristic octile
+"""),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    s.add_argument("map", help="MovingAI .map file")
+    s.add_argument("scen", help="MovingAI .scen file for that map")
+    s.add_argument("--limit", type=_positive_int, help="check only the first N lines")
+    s.add_argument("--heuristic", default="octile", choices=["octile", "euclidean"],
+                   help="A* heuristic (default octile; both are exact)")
+    s.add_argument("--tol", type=_float, default=1e-6, help="relative tolerance (default 1e-6)")
+    s.set_defaults(func=cmd_scen)
+
+    q = sub.add_parser(
+        "planners", help="list the registered planners and their default parameters",
+        description="List every planner in the registry with its default parameters.",
+        epilog="example:\n  pathfuse planners --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    q.add_argument("--json", action="store_true", help="print JSON")
+    q.set_defaults(func=cmd_planners)
+
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``pathfuse`` console script."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "command", None):
+        parser.print_help()
+        return EXIT_USAGE
+    try:
+        return int(args.func(args) or 0)
+    except PathfuseError as exc:
+        print(f"pathfuse {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except OSError as exc:
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        print(f"pathfuse {args.command}: error:{where} {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print(f"pathfuse {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

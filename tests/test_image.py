@@ -56,6 +56,9 @@ def test_rgb_is_mean_of_channels(tmp_path):
     Image.fromarray(rgb).save(p)
     # means 85, 170, 85 -> darkness .667, .333, .667
     assert read_image(p, 1.0).occupied.tolist() == [[True, False, True]]
+    # a luminance conversion (yellow 226, blue 29) would flip these two:
+    assert read_image(p, 1.0, threshold=0.2).occupied.tolist() == [[True, True, True]]
+    assert read_image(p, 1.0, threshold=0.8).occupied.tolist() == [[False, False, False]]
 
 
 def test_rgba_alpha_ignored(tmp_path):

@@ -87,7 +87,7 @@ from pathfuse.grid import GridMap
 from pathfuse.io.image import load_pixels
 from pathfuse.result import ConfigError, MapError, MapFormatError
 
-__all__ = ["read_ros_map", "write_ros_map", "ROS_MODES", "UNKNOWN_POLICIES"]
+__all__ = ["read_ros_map", "write_ros_map", "occupancy_values", "ROS_MODES", "UNKNOWN_POLICIES"]
 
 ROS_MODES = ("trinary", "scale", "raw")
 """The ``mode`` values map_server accepts."""

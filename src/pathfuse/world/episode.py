@@ -1,0 +1,363 @@
+"""The episode runner: one scenario, one online planner, one :class:`Episode` record.
+
+:func:`simulate` (exported as ``pathfuse.simulate``) reads a scenario, builds
+the :class:`~pathfuse.world.world.World` and the online planner, and steps
+them until the goal, a collision, a stall or the time limit::
+
+    ep = pathfuse.simulate("examples/scenarios/crossing.yaml", planner="astar-follow")
+    ep.status, ep.time_to_goal_s, ep.min_distance_m
+
+The :class:`Episode` holds everything needed to analyse or animate the run:
+the robot's trajectory with its times, every obstacle's position at every
+tick, the planner's global path(s), the sensing mask, per-tick planning times
+and the scene (map, radii, start, goal).
+
+Statuses
+--------
+``REACHED``        the robot's centre came within ``goal_tolerance`` of the goal
+``COLLISION``      the robot disc overlapped an occupied cell, the map's outside
+                   or a moving disc during a tick (checked continuously)
+``TIMEOUT``        the time limit passed
+``LOCAL_MINIMUM``  the robot stayed within ``stall_radius`` for ``stall_time``
+                   seconds, or the planner declared itself stuck
+``NO_PATH``        a planner that needs a global path found none on the static
+                   map (the robot did not move)
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pathfuse.grid import GridMap
+from pathfuse.result import path_length
+from pathfuse.world.online import (
+    OnlinePlanner,
+    PlannerContext,
+    get_online_planner,
+    make_online_params,
+    resolve_planner_choice,
+)
+from pathfuse.world.scenario import Scenario, load_scenario
+from pathfuse.world.world import World
+
+__all__ = ["Episode", "EpisodeStatus", "simulate", "run_episode"]
+
+
+class EpisodeStatus(enum.Enum):
+    """How an episode ended."""
+
+    REACHED = "reached"
+    COLLISION = "collision"
+    TIMEOUT = "timeout"
+    LOCAL_MINIMUM = "local_minimum"
+    NO_PATH = "no_path"
+
+    @property
+    def ok(self) -> bool:
+        return self is EpisodeStatus.REACHED
+
+
+@dataclass(frozen=True, eq=False)
+class Episode:
+    """The record of one simulated run.
+
+    Attributes
+    ----------
+    status : EpisodeStatus
+        How it ended.
+    planner : str
+        Online planner name.
+    params : dict
+        The planner parameters used (defaults filled in).
+    times : (T,) float array
+        Tick times in seconds, ``times[0] = 0``.
+    positions : (T, 2) float array
+        Robot centre at each tick (``positions[0]`` is the start).
+    velocities : (T - 1, 2) float array
+        Velocity used over each tick (after clipping to the speed limit).
+    obstacle_positions : (T, K, 2) float array
+        Every moving disc's centre at each tick.
+    obstacle_radii : (K,) float array
+        Disc radii.
+    sensed : (T, K) bool array
+        Which discs the planner observed at each tick.
+    global_path : (N, 2) float array or None
+        The planner's first global path (A* through cell centres), if any.
+    path_updates : list of (tick, (N, 2) array)
+        Every global path the planner adopted and the tick it did so
+        (more than one for replanning planners).
+    path_length_m : float
+        Length of the robot's trajectory.
+    time_to_goal_s : float or None
+        Time of the tick at which the goal was reached (None otherwise).
+    min_distance_m : float
+        Least clearance between the robot disc and any obstacle - static or
+        moving - over the whole run (exact over each tick; static clearances
+        are capped at 2 m).  Negative after a collision.
+    min_obstacle_distance_m : float
+        The same for the moving discs only (``inf`` without discs).
+    min_static_clearance_m : float
+        The same for the static map and its edge only.
+    n_ticks : int
+        Number of ticks simulated (``T - 1``).
+    plan_times_s : (T - 1,) float array
+        Wall-clock time of the planner's ``act`` at each tick.
+    setup_time_s : float
+        Wall-clock time of the planner's ``reset`` (global planning).
+    collision_with : str, int or None
+        ``"static"`` or the index of the disc hit.
+    message : str
+        A sentence about the outcome.
+    scenario : Scenario
+        The scenario run (map, robot, goal, obstacle specs).
+    seed : int or None
+        The episode seed.
+    """
+
+    status: EpisodeStatus
+    planner: str
+    params: dict[str, Any]
+    times: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray
+    obstacle_positions: np.ndarray
+    obstacle_radii: np.ndarray
+    sensed: np.ndarray
+    global_path: np.ndarray | None
+    path_updates: list[tuple[int, np.ndarray]]
+    path_length_m: float
+    time_to_goal_s: float | None
+    min_distance_m: float
+    min_obstacle_distance_m: float
+    min_static_clearance_m: float
+    n_ticks: int
+    plan_times_s: np.ndarray
+    setup_time_s: float
+    collision_with: Any
+    message: str
+    scenario: Scenario = field(repr=False)
+    seed: int | None = None
+
+    @property
+    def reached(self) -> bool:
+        return self.status is EpisodeStatus.REACHED
+
+    @property
+    def mean_plan_time_s(self) -> float:
+        """Mean wall-clock planning time per tick (0 without ticks)."""
+        return float(self.plan_times_s.mean()) if self.plan_times_s.size else 0.0
+
+    @property
+    def grid(self) -> GridMap:
+        return self.scenario.grid
+
+    @property
+    def robot_radius(self) -> float:
+        return self.scenario.robot.radius
+
+    def to_dict(self, trajectories: bool = True) -> dict[str, Any]:
+        """A JSON-ready dict (``trajectories=False`` leaves out the per-tick arrays)."""
+
+        def fin(x: float | None) -> float | None:
+            return None if x is None or not math.isfinite(x) else float(x)
+
+        d: dict[str, Any] = {
+            "scenario": self.scenario.name,
+            "planner": self.planner,
+            "params": dict(self.params),
+            "seed": self.seed,
+            "status": self.status.name,
+            "message": self.message,
+            "collision_with": self.collision_with,
+            "path_length_m": float(self.path_length_m),
+            "time_to_goal_s": fin(self.time_to_goal_s),
+            "min_distance_m": fin(self.min_distance_m),
+            "min_obstacle_distance_m": fin(self.min_obstacle_distance_m),
+            "min_static_clearance_m": fin(self.min_static_clearance_m),
+            "n_ticks": int(self.n_ticks),
+            "dt": float(self.scenario.dt),
+            "mean_plan_time_s": self.mean_plan_time_s,
+            "max_plan_time_s": float(self.plan_times_s.max()) if self.plan_times_s.size else 0.0,
+            "setup_time_s": float(self.setup_time_s),
+        }
+        if trajectories:
+            d["times"] = self.times.tolist()
+            d["positions"] = self.positions.tolist()
+            d["obstacle_positions"] = self.obstacle_positions.tolist()
+            d["obstacle_radii"] = self.obstacle_radii.tolist()
+            d["global_path"] = None if self.global_path is None else self.global_path.tolist()
+        return d
+
+
+def _stalled(positions: np.ndarray, n: int, window: int, radius: float) -> bool:
+    """Whether the last ``window + 1`` positions all lie within ``radius`` of the newest."""
+    if window <= 0 or n <= window:
+        return False
+    seg = positions[n - window - 1:n]
+    d = np.hypot(seg[:, 0] - positions[n - 1, 0], seg[:, 1] - positions[n - 1, 1])
+    return bool(d.max() < radius)
+
+
+def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = None,
+                params: dict[str, Any] | None = None) -> Episode:
+    """Run ``planner`` (an already built online planner) through ``scenario``."""
+    world = World(scenario)
+    sc = world.scenario
+    obs = world.reset(seed)
+    n_max = world.n_steps
+    k_obs = len(sc.obstacles)
+    positions = np.empty((n_max + 1, 2))
+    velocities = np.empty((n_max, 2))
+    sensed = np.zeros((n_max + 1, k_obs), dtype=bool)
+    plan_times = np.empty(n_max)
+    positions[0] = obs.position
+    sensed[0, obs.obstacles.ids] = True
+
+    ctx = PlannerContext(grid=sc.grid, start=np.array(sc.start, dtype=np.float64),
+                         goal=np.array(sc.goal, dtype=np.float64), robot=sc.robot, dt=sc.dt,
+                         goal_tolerance=sc.goal_tolerance)
+    planner.warmup()
+    t0 = time.perf_counter()
+    planner.reset(ctx)
+    setup = time.perf_counter() - t0
+    path_updates: list[tuple[int, np.ndarray]] = []
+    last_path = planner.global_path
+    if last_path is not None:
+        path_updates.append((0, np.array(last_path)))
+
+    min_static = world.static_gap(obs.position)
+    min_obst = math.inf
+    if k_obs:
+        q = world.obstacle_positions[0]
+        g0 = np.hypot(q[:, 0] - obs.position[0], q[:, 1] - obs.position[1]) \
+            - world.obstacle_radii - world.radius
+        min_obst = float(g0.min())
+    window = int(round(sc.stall_time / sc.dt)) if sc.stall_time > 0 else 0
+    status = EpisodeStatus.TIMEOUT
+    message = ""
+    collision_with = None
+    n = 1
+    if planner.failure is not None:
+        status, message = _failure_status(planner)
+    else:
+        while True:
+            t0 = time.perf_counter()
+            action = planner.act(obs)
+            plan_times[n - 1] = time.perf_counter() - t0
+            obs, terminated, truncated, info = world.step(action)
+            positions[n] = obs.position
+            velocities[n - 1] = obs.velocity
+            sensed[n, obs.obstacles.ids] = True
+            min_static = min(min_static, info["static_gap"])
+            min_obst = min(min_obst, info["obstacle_gap"])
+            n += 1
+            gp = planner.global_path
+            if gp is not None and gp is not last_path:
+                path_updates.append((n - 1, np.array(gp)))
+                last_path = gp
+            if terminated:
+                if info["event"] == "reached":
+                    status = EpisodeStatus.REACHED
+                    message = f"reached the goal at t = {obs.time:.2f} s"
+                else:
+                    status = EpisodeStatus.COLLISION
+                    collision_with = info["collision"]
+                    what = "the static map" if collision_with == "static" \
+                        else f"moving obstacle {collision_with}"
+                    message = f"collided with {what} during tick {n - 2} -> {n - 1} " \
+                              f"(t = {obs.time:.2f} s)"
+                break
+            if truncated:
+                message = f"time limit {sc.time_limit:g} s reached"
+                break
+            if planner.failure is not None:
+                status, message = _failure_status(planner)
+                break
+            if _stalled(positions, n, window, sc.stall_radius):
+                status = EpisodeStatus.LOCAL_MINIMUM
+                message = (f"stalled: stayed within {sc.stall_radius:g} m for "
+                           f"{sc.stall_time:g} s (t = {obs.time:.2f} s)")
+                break
+    t = n - 1
+    times = np.arange(n, dtype=np.float64) * sc.dt
+    pos = positions[:n].copy()
+    return Episode(
+        status=status,
+        planner=planner.name,
+        params=dict(params or {}),
+        times=times,
+        positions=pos,
+        velocities=velocities[:t].copy(),
+        obstacle_positions=np.array(world.obstacle_positions[:n]),
+        obstacle_radii=world.obstacle_radii.copy(),
+        sensed=sensed[:n].copy(),
+        global_path=None if not path_updates else path_updates[0][1],
+        path_updates=path_updates,
+        path_length_m=path_length(pos),
+        time_to_goal_s=float(times[-1]) if status is EpisodeStatus.REACHED else None,
+        min_distance_m=min(min_static, min_obst),
+        min_obstacle_distance_m=min_obst,
+        min_static_clearance_m=min_static,
+        n_ticks=t,
+        plan_times_s=plan_times[:t].copy(),
+        setup_time_s=setup,
+        collision_with=collision_with,
+        message=message,
+        scenario=sc,
+        seed=world.seed,
+    )
+
+
+def _failure_status(planner: OnlinePlanner) -> tuple[EpisodeStatus, str]:
+    kind, msg = planner.failure  # type: ignore[misc]
+    st = EpisodeStatus.NO_PATH if kind == "no_path" else EpisodeStatus.LOCAL_MINIMUM
+    return st, msg
+
+
+def simulate(scenario: Any, planner: Any = None, seed: int | None = None) -> Episode:
+    """Simulate one episode of a dynamic scenario.
+
+    Parameters
+    ----------
+    scenario : path, mapping or Scenario
+        A scenario YAML file, the same content as a dict, or a
+        :class:`~pathfuse.world.scenario.Scenario`.
+    planner : str or mapping, optional
+        An online planner name (``"fusion"``, ``"apf"``, ``"astar-follow"``,
+        ``"astar-replan"``, ``"ref6"``, ``"ref7"``) or ``{"name": ...,
+        "params": {...}}``; overrides the scenario's ``planner``.
+    seed : int, optional
+        Episode seed (default: the scenario's); the same scenario and seed
+        give the same episode, bit for bit.
+
+    Returns
+    -------
+    Episode
+
+    Raises
+    ------
+    ScenarioError, ConfigError
+        A malformed scenario or planner choice (the message names the key).
+
+    Examples
+    --------
+    >>> sc = {"map": {"rows": ["........", "........", "........"]},
+    ...       "start": [0.5, 1.5], "goal": [7.5, 1.5], "robot": {"radius": 0.2}}
+    >>> ep = simulate(sc, planner="astar-follow")
+    >>> ep.status.name, ep.n_ticks, round(ep.path_length_m, 6)
+    ('REACHED', 68, 6.8)
+    """
+    sc = load_scenario(scenario)
+    choice = resolve_planner_choice(sc.planner if planner is None else planner)
+    spec = get_online_planner(choice.name)
+    params = make_online_params(spec, choice.params, key="planner.params")
+    obj = spec.factory(params)
+    import dataclasses
+
+    return run_episode(sc, obj, seed=seed, params=dataclasses.asdict(params))

@@ -1,0 +1,293 @@
+"""The simulated world: a disc robot, a static map and moving discs, stepped tick by tick.
+
+:class:`World` follows the Gymnasium ``reset`` / ``step`` pattern (without
+depending on Gymnasium and without a reward)::
+
+    world = World(scenario)
+    obs = world.reset(seed=0)
+    while True:
+        obs, terminated, truncated, info = world.step(velocity)
+        if terminated or truncated:
+            break
+
+The action
+----------
+The action is a **velocity** ``(vx, vy)`` in m/s, held for one tick of
+``dt`` seconds.  Its norm is clipped to ``robot.max_speed`` (direction kept),
+so the robot moves in a straight line from ``p`` to ``p + v * dt``.
+
+Collisions (checked over the whole tick, not at its end points)
+---------------------------------------------------------------
+* Static: the robot disc swept along its segment overlaps an occupied cell
+  or leaves the map - exactly, with
+  :func:`~pathfuse.world.geometry.segment_static_distance` (closed-form
+  segment-to-square distances; no sampling, so no step size is too large).
+* Moving discs: both centres move linearly over the tick, so their distance
+  is minimised in closed form
+  (:func:`~pathfuse.world.geometry.disc_sweep_gaps`).
+
+``terminated`` is ``True`` on a collision or when the robot's centre passes
+within ``goal_tolerance`` of the goal during the tick (a collision in the
+same tick wins: the conservative reading); ``truncated`` is ``True`` when the
+tick count reaches ``ceil(time_limit / dt)``.
+
+Sensing
+-------
+The observation holds the robot's state, the goal and the moving discs
+whose surface lies within ``robot.sensing_radius`` of the robot's centre
+*now*: their ids, positions, current velocities (the velocity they had over
+the last tick, or their initial velocity at tick 0) and radii.  Obstacle
+trajectories are precomputed at :meth:`World.reset` (they are a pure
+function of the scenario and the seed), but planners only ever see
+observations, so they never read the future.
+
+Examples
+--------
+>>> from pathfuse.world.scenario import load_scenario
+>>> sc = load_scenario({"map": {"rows": ["....."]}, "start": [0.5, 0.5],
+...                     "goal": [4.5, 0.5], "robot": {"radius": 0.2}, "dt": 0.5})
+>>> w = World(sc)
+>>> obs = w.reset()
+>>> obs.position.tolist(), obs.obstacles.positions.shape
+([0.5, 0.5], (0, 2))
+>>> for _ in range(8):
+...     obs, term, trunc, info = w.step((5.0, 0.0))      # clipped to 1 m/s
+...     if term or trunc:
+...         break
+>>> info["event"], obs.tick, obs.position.tolist()
+('reached', 8, [4.5, 0.5])
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from pathfuse.result import PathfuseError, QueryError
+from pathfuse.world.geometry import (
+    disc_sweep_gaps,
+    point_segment_distance,
+    segment_static_distance,
+)
+from pathfuse.world.obstacles import obstacle_trajectories
+from pathfuse.world.scenario import Scenario, load_scenario
+
+__all__ = ["World", "Observation", "SensedObstacles", "STATIC_CLEARANCE_CAP_M"]
+
+STATIC_CLEARANCE_CAP_M = 2.0
+"""Static clearances are computed exactly up to this many metres and reported capped at it."""
+
+
+@dataclass(frozen=True)
+class SensedObstacles:
+    """The moving discs inside the sensing radius at one tick.
+
+    Attributes
+    ----------
+    ids : (M,) int array
+        Indices into the scenario's ``obstacles``.
+    positions : (M, 2) float array
+        Centres (metres).
+    velocities : (M, 2) float array
+        Current velocities (m/s): the last tick's displacement over ``dt``
+        (the initial velocity at tick 0).
+    radii : (M,) float array
+        Radii (metres).
+    """
+
+    ids: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray
+    radii: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.ids.shape[0])
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What a planner sees at one tick.
+
+    Attributes
+    ----------
+    tick : int
+        Tick index (0 at reset).
+    time : float
+        ``tick * dt`` in seconds.
+    position : (2,) float array
+        Robot centre.
+    velocity : (2,) float array
+        The velocity the robot moved with over the last tick (zero at reset).
+    goal : (2,) float array
+        The goal.
+    obstacles : SensedObstacles
+        Moving discs within the sensing radius.
+    """
+
+    tick: int
+    time: float
+    position: np.ndarray
+    velocity: np.ndarray
+    goal: np.ndarray
+    obstacles: SensedObstacles
+
+
+class World:
+    """A scenario brought to life: the clock, the robot state and the moving discs.
+
+    Parameters
+    ----------
+    scenario : Scenario, path or mapping
+        Anything :func:`~pathfuse.world.scenario.load_scenario` reads.
+    """
+
+    def __init__(self, scenario: Any) -> None:
+        self.scenario: Scenario = load_scenario(scenario)
+        sc = self.scenario
+        g = sc.grid
+        self._occ = g.occupied
+        self._ox = float(g.origin[0])
+        self._oy = float(g.origin[1])
+        self._res = float(g.resolution)
+        self.dt = float(sc.dt)
+        self.n_steps = sc.n_steps
+        self.radius = float(sc.robot.radius)
+        self.max_speed = float(sc.robot.max_speed)
+        self.sensing_radius = float(sc.robot.sensing_radius)
+        self.goal = np.array(sc.goal, dtype=np.float64)
+        self.obstacle_radii = np.array([ob.radius for ob in sc.obstacles], dtype=np.float64)
+        self._tick = -1
+        self._done = True
+        self.seed: int | None = None
+        self.obstacle_positions = np.zeros((0, 0, 2))
+        self.obstacle_velocities = np.zeros((0, 0, 2))
+        self.position = np.array(sc.start, dtype=np.float64)
+        self.velocity = np.zeros(2)
+
+    # ------------------------------------------------------------------ state
+    @property
+    def tick(self) -> int:
+        return self._tick
+
+    @property
+    def time(self) -> float:
+        return self._tick * self.dt
+
+    @property
+    def done(self) -> bool:
+        return self._done
+
+    def static_gap(self, a: np.ndarray, b: np.ndarray | None = None) -> float:
+        """Clearance of the robot disc swept from ``a`` to ``b`` to the static map.
+
+        Negative means overlap; capped at :data:`STATIC_CLEARANCE_CAP_M`.
+        """
+        b = a if b is None else b
+        d = segment_static_distance(self._occ, self._ox, self._oy, self._res, float(a[0]),
+                                    float(a[1]), float(b[0]), float(b[1]),
+                                    self.radius + STATIC_CLEARANCE_CAP_M)
+        return float(d) - self.radius
+
+    def _sense(self) -> SensedObstacles:
+        k = self._tick
+        if self.obstacle_radii.shape[0] == 0:
+            return SensedObstacles(np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros((0, 2)),
+                                   np.zeros(0))
+        q = self.obstacle_positions[k]
+        d = np.hypot(q[:, 0] - self.position[0], q[:, 1] - self.position[1]) - self.obstacle_radii
+        ids = np.flatnonzero(d <= self.sensing_radius)
+        return SensedObstacles(ids, q[ids].copy(), self.obstacle_velocities[k, ids].copy(),
+                               self.obstacle_radii[ids].copy())
+
+    def observe(self) -> Observation:
+        """The observation at the current tick."""
+        if self._tick < 0:
+            raise PathfuseError("the world has not been reset; call reset() first")
+        return Observation(self._tick, self._tick * self.dt, self.position.copy(),
+                           self.velocity.copy(), self.goal.copy(), self._sense())
+
+    # ------------------------------------------------------------------ gym-style API
+    def reset(self, seed: int | None = None) -> Observation:
+        """Start an episode: the robot at the start, the clock at 0, the discs at tick 0.
+
+        ``seed`` (default: the scenario's ``seed``) is mixed into the random
+        walks' seeds; the same scenario and seed give the same episode.
+        """
+        sc = self.scenario
+        self.seed = sc.seed if seed is None else int(seed)
+        self.obstacle_positions, self.obstacle_velocities = obstacle_trajectories(
+            sc.obstacles, sc.grid, self.dt, self.n_steps, self.seed)
+        self.obstacle_positions.setflags(write=False)
+        self.obstacle_velocities.setflags(write=False)
+        self.position = np.array(sc.start, dtype=np.float64)
+        self.velocity = np.zeros(2)
+        self._tick = 0
+        self._done = False
+        return self.observe()
+
+    def clip_action(self, action: Any) -> tuple[np.ndarray, bool]:
+        """The velocity the robot will really use, and whether it was clipped."""
+        try:
+            v = np.asarray(action, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError):
+            raise QueryError(f"action must be a velocity (vx, vy), got {action!r}") from None
+        if v.shape != (2,) or not np.all(np.isfinite(v)):
+            raise QueryError(f"action must be a finite velocity (vx, vy), got {action!r}")
+        s = math.hypot(v[0], v[1])
+        if s > self.max_speed:
+            return v * (self.max_speed / s), True
+        return v, False
+
+    def step(self, action: Any) -> tuple[Observation, bool, bool, dict[str, Any]]:
+        """Move the robot with velocity ``action`` for one tick and the discs with it.
+
+        Returns
+        -------
+        observation : Observation
+        terminated : bool
+            Goal reached or collision.
+        truncated : bool
+            The time limit was reached without termination.
+        info : dict
+            ``event`` ("reached", "collision" or None), ``collision``
+            ("static", the index of the disc hit, or None), ``static_gap``
+            and ``obstacle_gap`` (least clearance over the tick, metres;
+            ``inf`` without discs), ``clipped`` (speed limited).
+        """
+        if self._done:
+            raise PathfuseError("the episode is over; call reset() to start another")
+        v, clipped = self.clip_action(action)
+        k = self._tick
+        p0 = self.position
+        p1 = p0 + v * self.dt
+        static_gap = self.static_gap(p0, p1)
+        obstacle_gap = math.inf
+        hit_disc = -1
+        if self.obstacle_radii.shape[0]:
+            gaps = disc_sweep_gaps(p0, p1, self.radius, self.obstacle_positions[k],
+                                   self.obstacle_positions[k + 1], self.obstacle_radii)
+            j = int(np.argmin(gaps))
+            obstacle_gap = float(gaps[j])
+            if obstacle_gap < 0.0:
+                hit_disc = j
+        event = None
+        collision: Any = None
+        if static_gap < 0.0:
+            event, collision = "collision", "static"
+        elif hit_disc >= 0:
+            event, collision = "collision", hit_disc
+        elif point_segment_distance(self.goal[0], self.goal[1], p0[0], p0[1], p1[0],
+                                    p1[1]) <= self.scenario.goal_tolerance:
+            event = "reached"
+        self.position = p1
+        self.velocity = v
+        self._tick = k + 1
+        terminated = event is not None
+        truncated = (not terminated) and self._tick >= self.n_steps
+        self._done = terminated or truncated
+        info = {"event": event, "collision": collision, "static_gap": static_gap,
+                "obstacle_gap": obstacle_gap, "clipped": clipped}
+        return self.observe(), terminated, truncated, info

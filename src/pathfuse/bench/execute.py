@@ -1,0 +1,464 @@
+"""Worker side of a sweep: run a batch of runs and return their result rows.
+
+Everything here runs in a worker process (a local process pool, a Dask
+worker, or the client itself when ``workers=1``).  Workers never touch the
+result store; they return plain dicts that the client writes.
+
+A *batch* is a list of *groups*; a group is a map instance (a ``map_key``
+with its loadable spec, or the map object itself) and the runs on it.  Loaded
+maps, inflated maps and reference lengths are cached per process, so a
+worker that gets many batches on the same map loads it once.
+
+The run **kind** selects the executor (:data:`KINDS`): ``"static"`` plans with
+:func:`pathfuse.plan` on a map; ``"dynamic"`` runs an episode with
+:func:`pathfuse.world.simulate`.  A run that raises becomes a row with
+``status_name = "ERROR"`` and the error text; it never stops the batch.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import importlib
+import importlib.util
+import json
+import math
+import os
+import resource
+import socket
+import sys
+import threading
+import time
+import traceback
+from collections import OrderedDict
+from collections.abc import Callable, Mapping, Sequence
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["execute_batch", "execute_run", "ensure_imports", "KINDS", "clear_caches"]
+
+_MAP_CACHE_SIZE = 8
+_MAPS: OrderedDict[Any, Any] = OrderedDict()
+_REFS: OrderedDict[Any, tuple[float | None, str | None]] = OrderedDict()
+_IMPORTED: set[str] = set()
+_LOCK = threading.RLock()  # Dask workers may run several threads
+
+
+def clear_caches() -> None:
+    """Forget the maps and reference lengths cached in this process."""
+    _MAPS.clear()
+    _REFS.clear()
+
+
+def _lru_put(cache: OrderedDict[Any, Any], key: Any, value: Any, size: int) -> None:
+    cache[key] = value
+    cache.move_to_end(key)
+    while len(cache) > size:
+        cache.popitem(last=False)
+
+
+def ensure_imports(imports: Sequence[str]) -> None:
+    """Import plug-in modules (names or ``.py`` paths) once per process."""
+    for imp in imports:
+        if imp in _IMPORTED:
+            continue
+        if imp.endswith(".py") and not Path(imp).is_file():
+            # a Dask worker on another machine: the client uploaded the file
+            importlib.import_module(Path(imp).stem)
+        elif imp.endswith(".py"):
+            path = Path(imp).resolve()
+            digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
+            mod_name = "pathfuse_plugin_" + "".join(
+                c if c.isalnum() else "_" for c in path.stem) + f"_{digest}"
+            if mod_name not in sys.modules:
+                spec = importlib.util.spec_from_file_location(mod_name, path)
+                if spec is None or spec.loader is None:
+                    raise ImportError(f"cannot import {path}")
+                mod = importlib.util.module_from_spec(spec)
+                sys.modules[mod_name] = mod
+                try:
+                    spec.loader.exec_module(mod)
+                except BaseException:
+                    del sys.modules[mod_name]
+                    raise
+        else:
+            importlib.import_module(imp)
+        _IMPORTED.add(imp)
+
+
+# --------------------------------------------------------------------------- batch
+def execute_batch(batch: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """Run every run of ``batch``; one result row (dict) per run, in order.
+
+    ``batch = {"imports": [...], "store_paths": bool, "groups": [group, ...]}``
+    with ``group = {"kind", "map_key", "map_spec", "base_dir", "grid" (optional
+    map object), "runs": [run, ...]}``; a run carries ``key``, ``planner``,
+    ``params``, ``seed``, ``query``, ``limits``, ``robot_radius_m``,
+    ``reference``.
+    """
+    ensure_imports(batch.get("imports", ()))
+    out: list[dict[str, Any]] = []
+    for group in batch["groups"]:
+        for run in group["runs"]:
+            out.append(execute_run(group, run, store_paths=bool(batch.get("store_paths"))))
+    return out
+
+
+def execute_run(group: Mapping[str, Any], run: Mapping[str, Any],
+                store_paths: bool = False) -> dict[str, Any]:
+    """Run one run; never raises an ``Exception`` (it becomes an ERROR row)."""
+    started = datetime.now(timezone.utc)
+    t0 = time.perf_counter()
+    row: dict[str, Any] = {"run_key": run["key"]}
+    try:
+        kind = group["kind"]
+        fn = KINDS.get(kind)
+        if fn is None:
+            raise ValueError(f"unknown run kind {kind!r}; known kinds: {', '.join(KINDS)}")
+        row.update(fn(group, run, store_paths))
+    except Exception as exc:  # noqa: BLE001 - a failing run is data, not a crash
+        row.update(_error_row(exc))
+    row["wall_time"] = time.perf_counter() - t0
+    row["started_at"] = started.isoformat(timespec="microseconds")
+    row["finished_at"] = datetime.now(timezone.utc).isoformat(timespec="microseconds")
+    row["memory"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    row["host"] = socket.gethostname()
+    row["worker"] = _worker_name()
+    from pathfuse import __version__
+
+    row["pathfuse_version"] = __version__
+    return row
+
+
+def _worker_name() -> str:
+    try:
+        from distributed import get_worker  # type: ignore[import-not-found]
+
+        return str(get_worker().address)
+    except Exception:  # noqa: BLE001 - not on a dask worker (or no dask)
+        return f"pid {os.getpid()}"
+
+
+def _error_row(exc: BaseException) -> dict[str, Any]:
+    text = "".join(traceback.format_exception_only(type(exc), exc)).strip()
+    return {"status_name": "ERROR", "solved": False, "error": text,
+            "traceback": "".join(traceback.format_exception(type(exc), exc,
+                                                            exc.__traceback__))}
+
+
+# --------------------------------------------------------------------------- maps
+def _grid(group: Mapping[str, Any]) -> Any:
+    with _LOCK:
+        return _grid_locked(group)
+
+
+def _grid_locked(group: Mapping[str, Any]) -> Any:
+    key = group["map_key"]
+    if key in _MAPS:
+        _MAPS.move_to_end(key)
+        return _MAPS[key]
+    grid = group.get("grid")
+    if grid is None:
+        from pathfuse.bench.experiment import load_map
+
+        grid = load_map(group["map_spec"], group.get("base_dir") or ".")
+    _lru_put(_MAPS, key, grid, _MAP_CACHE_SIZE)
+    return grid
+
+
+def _inflated(group: Mapping[str, Any], grid: Any, radius: float) -> Any:
+    if radius <= 0:
+        return grid
+    key = (group["map_key"], "inflate", float(radius))
+    with _LOCK:
+        if key not in _MAPS:
+            _lru_put(_MAPS, key, grid.inflate(radius), _MAP_CACHE_SIZE)
+        return _MAPS[key]
+
+
+def random_query(grid: Any, seed: int, index: int, min_distance_m: float,
+                 map_key: str = "", attempts: int = 1000) -> tuple[np.ndarray, np.ndarray]:
+    """A deterministic random (start, goal) pair of free cell centres in one component.
+
+    The pair depends only on the map, ``seed`` and ``index``.  Raises
+    ``ValueError`` when no pair ``min_distance_m`` apart is found in
+    ``attempts`` draws.
+
+    >>> from pathfuse.grid import GridMap
+    >>> g = GridMap.from_rows(["....", ".##.", "...."])
+    >>> s, t = random_query(g, seed=1, index=0, min_distance_m=2.0)
+    >>> bool(g.is_free(np.array([s, t])).all()), float(np.hypot(*(s - t))) >= 2.0
+    (True, True)
+    """
+    free = np.flatnonzero(~grid.occupied.ravel())
+    if free.size < 2:
+        raise ValueError(f"map {grid.name!r} has fewer than two free cells")
+    labels = _component_labels(grid)
+    salt = int.from_bytes(bytes.fromhex(map_key[:8]), "big") if map_key else 0
+    rng = np.random.default_rng([int(seed), int(index), salt])
+    w = grid.width
+    for _ in range(attempts):
+        a, b = rng.choice(free, size=2, replace=False)
+        ra, ca = divmod(int(a), w)
+        rb, cb = divmod(int(b), w)
+        if labels[ra, ca] != labels[rb, cb]:
+            continue
+        pts = grid.cell_to_world(np.array([[ra, ca], [rb, cb]]))
+        if float(np.hypot(*(pts[0] - pts[1]))) >= min_distance_m:
+            return pts[0], pts[1]
+    raise ValueError(f"no random start/goal pair {min_distance_m:g} m apart in one free "
+                     f"region of map {grid.name!r} after {attempts} draws")
+
+
+def _component_labels(grid: Any) -> np.ndarray:
+    comps = getattr(grid, "components", None)
+    labels = comps() if callable(comps) else comps
+    if isinstance(labels, tuple):
+        labels = labels[0]
+    if labels is None or np.shape(labels) != grid.shape:
+        from scipy import ndimage
+
+        labels, _ = ndimage.label(~grid.occupied)
+    return np.asarray(labels)
+
+
+def _query_points(group: Mapping[str, Any], run: Mapping[str, Any],
+                  grid: Any) -> tuple[np.ndarray, np.ndarray]:
+    q = run["query"]
+    if "random" in q:
+        return random_query(grid, run["seed"], q["random"], q.get("min_distance_m", 0.0),
+                            group["map_key"])
+    return np.asarray(q["start"], dtype=float), np.asarray(q["goal"], dtype=float)
+
+
+# --------------------------------------------------------------------------- static runs
+def _plan_params(planner: str, params: Mapping[str, Any]) -> dict[str, Any]:
+    """Params from JSON (lists) back to the dataclass defaults' types (tuples)."""
+    from pathfuse.planners.registry import get_planner
+
+    defaults = get_planner(planner).defaults()
+    out = {}
+    for k, v in params.items():
+        d = defaults.get(k)
+        out[k] = tuple(v) if isinstance(d, tuple) and isinstance(v, list) else v
+    return out
+
+
+def _budget(limits: Mapping[str, Any]) -> Any:
+    from pathfuse.result import Budget
+
+    return Budget(max_iterations=limits.get("max_iterations"),
+                  time_limit_s=limits.get("time_limit_s"))
+
+
+def _reference(group: Mapping[str, Any], run: Mapping[str, Any], pgrid: Any,
+               start: np.ndarray, goal: np.ndarray) -> tuple[float | None, str | None]:
+    ref = run.get("reference")
+    if ref is None:
+        return None, None
+    q = run["query"]
+    if "optimal_length" in q and run["robot_radius_m"] <= 0:
+        return float(q["optimal_length"]), "scen"
+    key = (group["map_key"], float(run["robot_radius_m"]), ref["planner"],
+           json.dumps(ref.get("params") or {}, sort_keys=True),
+           tuple(np.round(start, 9)), tuple(np.round(goal, 9)))
+    with _LOCK:
+        if key in _REFS:
+            return _REFS[key]
+    import pathfuse
+
+    res = pathfuse.plan(pgrid, start, goal, planner=ref["planner"],
+                        budget=_budget(run["limits"]),
+                        **_plan_params(ref["planner"], ref.get("params") or {}))
+    val = (float(res.length), ref["planner"]) if res.success else (None, ref["planner"])
+    with _LOCK:
+        _lru_put(_REFS, key, val, 4096)
+    return val
+
+
+def _metrics(grid: Any, result: Any, radius: float) -> dict[str, Any] | None:
+    try:
+        from pathfuse.metrics import evaluate  # type: ignore[import-not-found]
+    except ImportError:
+        return None
+    return dict(evaluate(grid, result, radius))
+
+
+def _num(v: Any) -> float | None:
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        return None
+    return f if math.isfinite(f) else None
+
+
+def _pick(d: Mapping[str, Any], *names: str) -> Any:
+    for n in names:
+        if n in d:
+            return d[n]
+    return None
+
+
+def _scalars(d: Mapping[str, Any]) -> dict[str, Any]:
+    """The JSON-friendly scalar entries of a dict (numbers, strings, bools)."""
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        if isinstance(v, (bool, np.bool_)):
+            out[str(k)] = bool(v)
+        elif isinstance(v, (int, np.integer)):
+            out[str(k)] = int(v)
+        elif isinstance(v, (float, np.floating)):
+            out[str(k)] = float(v) if math.isfinite(float(v)) else None
+        elif isinstance(v, str):
+            out[str(k)] = v
+    return out
+
+
+def _is_timing(key: str) -> bool:
+    k = key.lower()
+    return "time" in k or k.endswith(("_s", "per_s", "_ms", "_us", "_ns")) or "rate" in k
+
+
+def _split_info(info: Mapping[str, Any]) -> dict[str, str]:
+    """Planner extras as JSON: ``info`` (reproducible) and ``timing`` (clock readings)."""
+    sc = _scalars(info)
+    timing = {k: v for k, v in sc.items() if _is_timing(k)}
+    rest = {k: v for k, v in sc.items() if k not in timing}
+    return {"info": json.dumps(rest, sort_keys=True),
+            "timing": json.dumps(timing, sort_keys=True)}
+
+
+def _metric_columns(m: Mapping[str, Any] | None) -> dict[str, Any]:
+    if not m:
+        return {}
+    cf = _pick(m, "collision_free")
+    coll = _pick(m, "collisions", "collision_count", "n_collisions")
+    if coll is None and cf is not None:
+        coll = 0 if bool(cf) else 1
+    steps = _pick(m, "steps", "n_steps")
+    return {
+        "solution_clearance": _num(_pick(m, "min_clearance_m", "min_clearance",
+                                         "clearance_m", "clearance")),
+        "solution_smoothness": _num(_pick(m, "smoothness", "smoothness_rad",
+                                          "total_turn_rad", "smoothness_total")),
+        "collision_free": None if cf is None else bool(cf),
+        "collisions": None if coll is None else int(coll),
+        "steps": None if steps is None else int(steps),
+        "metrics": json.dumps(_scalars(m), sort_keys=True),
+    }
+
+
+def _path_blob(path: np.ndarray) -> bytes:
+    return np.ascontiguousarray(path, dtype="<f8").tobytes()
+
+
+def run_static(group: Mapping[str, Any], run: Mapping[str, Any],
+               store_paths: bool) -> dict[str, Any]:
+    """Plan one static query and measure it (the ``"static"`` kind)."""
+    import pathfuse
+
+    grid = _grid(group)
+    radius = float(run["robot_radius_m"])
+    pgrid = _inflated(group, grid, radius)
+    start, goal = _query_points(group, run, pgrid)
+    res = pathfuse.plan(pgrid, start, goal, planner=run["planner"],
+                        budget=_budget(run["limits"]),
+                        **_plan_params(run["planner"], run["params"]))
+    path = np.asarray(res.path, dtype=float).reshape(-1, 2)
+    row: dict[str, Any] = {
+        "status_name": res.status.name,
+        "solved": bool(res.success),
+        "time": float(res.time_s),
+        "solution_length": float(res.length) if res.success else None,
+        "expansions": int(res.expansions),
+        "iterations": int(res.iterations),
+        "message": res.message,
+        "start_x": float(start[0]), "start_y": float(start[1]),
+        "goal_x": float(goal[0]), "goal_y": float(goal[1]),
+        "solution_segments": max(0, int(path.shape[0]) - 1) if res.success else None,
+    }
+    row.update(_split_info(res.info or {}))
+    if path.shape[0] >= 2:
+        row.update(_metric_columns(_metrics(grid, res, radius)))
+    ref_len, ref_src = _reference(group, run, pgrid, start, goal)
+    row["reference_length"] = ref_len
+    row["reference_source"] = ref_src
+    if res.success and ref_len:
+        row["R_length"] = (float(res.length) - ref_len) / ref_len
+    if store_paths and path.shape[0]:
+        row["path"] = _path_blob(path)
+    return row
+
+
+# --------------------------------------------------------------------------- dynamic runs
+def run_dynamic(group: Mapping[str, Any], run: Mapping[str, Any],
+                store_paths: bool) -> dict[str, Any]:
+    """One episode in a dynamic world (the ``"dynamic"`` kind).
+
+    SEAM: written against ``pathfuse.world.simulate(scenario, planner=...,
+    seed=..., **params) -> Episode``; the Episode's fields are read by name
+    (status, path, time_s, time_to_goal, collisions, length, ...), so the
+    columns fill in as the world module defines them.
+    """
+    try:
+        from pathfuse import world  # type: ignore[attr-defined]
+
+        simulate = world.simulate
+    except (ImportError, AttributeError):
+        raise RuntimeError("dynamic runs need pathfuse.world.simulate, which this build "
+                           "does not have yet") from None
+    scenario = group["map_spec"]["dynamic"]
+    params = dict(run["params"])
+    params.pop("seed", None)
+    kwargs: dict[str, Any] = {"planner": run["planner"], "seed": int(run["seed"])}
+    if params:
+        kwargs["params"] = _plan_params(run["planner"], params)
+    ep = simulate(scenario, **kwargs)
+    return episode_row(ep, store_paths)
+
+
+def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
+    """Result columns from an Episode-like object (attributes read by name)."""
+    d = dataclasses.asdict(ep) if dataclasses.is_dataclass(ep) else dict(vars(ep))
+    status = d.get("status")
+    name = getattr(status, "name", status)
+    name = str(name).upper() if name is not None else "UNKNOWN"
+    solved = bool(d.get("success", d.get("reached", name == "SUCCESS")))
+    path = d.get("path")
+    path = np.asarray(path, dtype=float).reshape(-1, 2) if path is not None else None
+    length = _num(d.get("length", d.get("length_m")))
+    if length is None and path is not None and path.shape[0] >= 2:
+        length = float(np.hypot(*np.diff(path, axis=0).T).sum())
+    coll = d.get("collisions", d.get("n_collisions"))
+    if isinstance(coll, (list, tuple)):
+        coll = len(coll)
+    row: dict[str, Any] = {
+        "status_name": name,
+        "solved": solved,
+        "time": _num(d.get("time_s", d.get("planning_time_s", d.get("compute_time_s")))),
+        "solution_length": length if solved else None,
+        "time_to_goal": _num(d.get("time_to_goal", d.get("time_to_goal_s")))
+        if solved else None,
+        "collisions": None if coll is None else int(coll),
+        "collision_free": None if coll is None else int(coll) == 0,
+        "iterations": int(d.get("steps", d.get("iterations", 0)) or 0),
+        "steps": None if d.get("steps") is None else int(d["steps"]),
+        "message": str(d.get("message", "")),
+        "solution_clearance": _num(d.get("min_clearance_m", d.get("min_clearance"))),
+        "metrics": json.dumps(_scalars(d), sort_keys=True),
+    }
+    if path is not None and path.shape[0]:
+        row["start_x"], row["start_y"] = map(float, path[0])
+        if store_paths:
+            row["path"] = _path_blob(path)
+    return row
+
+
+KINDS: dict[str, Callable[[Mapping[str, Any], Mapping[str, Any], bool], dict[str, Any]]] = {
+    "static": run_static,
+    "dynamic": run_dynamic,
+}
+"""Run kind -> executor.  Register a new kind here (it gets its own rows)."""

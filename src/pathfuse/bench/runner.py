@@ -1,0 +1,565 @@
+"""Run a sweep: expand the experiment, skip what is stored, execute the rest, store it.
+
+:func:`run_bench` is what ``pathfuse bench`` calls.  Execution backends:
+
+* ``workers=1``: in this process, one run after another, each committed as
+  it finishes;
+* ``workers=N`` (default: the CPUs this process may use): a local process
+  pool; runs travel in batches that share maps, which each worker caches;
+* ``scheduler="tcp://HOST:PORT"``: an existing Dask distributed cluster
+  (``pip install pathfuse[dask]``); workers only compute, this process (the
+  client) writes the store.
+
+The client is the only writer.  A sweep that is interrupted (Ctrl-C,
+``kill -9``, a crashed worker, a lost cluster) and started again with the
+same command runs only the runs whose keys are not yet stored, and ends with
+the same result set as an uninterrupted sweep (wall-clock columns aside).
+A worker process that dies (segfault, ``os._exit``, out of memory) takes
+its batch down with it; the runner re-runs the batches that were in flight
+one run at a time in a fresh single-worker pool, so the run that kills its
+worker is stored as an ``ERROR`` ("worker process died") and the others
+complete.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing as mp
+import os
+import signal
+import sys
+import time
+from collections import deque
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from pathfuse.bench.execute import ensure_imports, execute_batch, execute_run
+from pathfuse.bench.experiment import (
+    Experiment,
+    RunSpec,
+    canonical_json,
+    file_digest,
+    iter_groups,
+    load_experiment,
+    load_map,
+)
+from pathfuse.bench.progress import ProgressBar
+from pathfuse.bench.store import ResultStore
+from pathfuse.result import ConfigError
+
+__all__ = ["run_bench", "SweepSummary", "SweepInterrupted", "make_batches", "default_workers"]
+
+CRASH_TEXT = ("WorkerCrashed: the worker process died while running this run "
+              "(segfault, os._exit, out of memory or killed)")
+
+
+@dataclass
+class SweepSummary:
+    """What a sweep did.  ``str(summary)`` is a short human report."""
+
+    experiment: str
+    db_path: str
+    total: int = 0
+    skipped: int = 0
+    ran: int = 0
+    succeeded: int = 0
+    failed: int = 0
+    errors: int = 0
+    crashed: int = 0
+    interrupted: bool = False
+    wall_s: float = 0.0
+    workers: int = 1
+    scheduler: str | None = None
+    error_samples: list[str] = field(default_factory=list)
+
+    @property
+    def runs_per_s(self) -> float:
+        return self.ran / self.wall_s if self.wall_s > 0 else 0.0
+
+    @property
+    def complete(self) -> bool:
+        """True when every run of the experiment is now stored."""
+        return self.skipped + self.ran == self.total
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["runs_per_s"] = self.runs_per_s
+        d["complete"] = self.complete
+        return d
+
+    def __str__(self) -> str:
+        where = self.scheduler or (f"{self.workers} worker" + ("s" if self.workers > 1 else ""))
+        head = (f"{self.experiment}: {self.ran} runs in {self.wall_s:.1f} s "
+                f"({self.runs_per_s:.1f} runs/s, {where}); {self.skipped} already stored; "
+                f"{self.skipped + self.ran}/{self.total} in {self.db_path}")
+        tail = f"\n  solved {self.succeeded}, not solved {self.failed}, errors {self.errors}"
+        if self.crashed:
+            tail += f" ({self.crashed} crashed their worker)"
+        if self.interrupted:
+            tail += "\n  interrupted: run the same command again to finish the missing runs"
+        for e in self.error_samples:
+            tail += f"\n  error: {e}"
+        return head + tail
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep; ``.summary`` holds what was stored before it."""
+
+    def __init__(self, summary: SweepSummary) -> None:
+        super().__init__(str(summary))
+        self.summary = summary
+
+
+def default_workers() -> int:
+    """CPUs this process may run on."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+# --------------------------------------------------------------------------- batching
+def make_batches(runs: Sequence[RunSpec], workers: int,
+                 batch_size: int | None = None) -> list[list[list[RunSpec]]]:
+    """Pack runs into batches of at most ``batch_size`` runs; a batch is a list of groups
+    (consecutive runs on the same map instance), so a worker loads each map once.
+
+    The default size gives each worker about eight batches, capped at 64 runs.
+    """
+    if not runs:
+        return []
+    if batch_size is None:
+        batch_size = max(1, min(64, math.ceil(len(runs) / (max(1, workers) * 8))))
+    batches: list[list[list[RunSpec]]] = []
+    cur: list[list[RunSpec]] = []
+    n = 0
+    for group in iter_groups(runs):
+        for i in range(0, len(group), batch_size):
+            chunk = group[i:i + batch_size]
+            if n + len(chunk) > batch_size and cur:
+                batches.append(cur)
+                cur, n = [], 0
+            cur.append(chunk)
+            n += len(chunk)
+    if cur:
+        batches.append(cur)
+    return batches
+
+
+def _run_payload(r: RunSpec) -> dict[str, Any]:
+    return {"key": r.key, "planner": r.planner, "params": r.params, "seed": r.seed,
+            "query": r.query, "limits": r.limits, "robot_radius_m": r.robot_radius_m,
+            "reference": r.reference}
+
+
+def _group_payload(exp: Experiment, chunk: Sequence[RunSpec],
+                   grids: dict[str, Any] | None = None) -> dict[str, Any]:
+    r0 = chunk[0]
+    g: dict[str, Any] = {"kind": r0.kind, "map_key": r0.map_key, "map_spec": r0.map_spec,
+                         "base_dir": str(exp.base_dir.resolve()),
+                         "runs": [_run_payload(r) for r in chunk]}
+    if grids and r0.map_key in grids:
+        g["grid"] = grids[r0.map_key]
+    return g
+
+
+def _batch_payload(exp: Experiment, batch: Sequence[Sequence[RunSpec]],
+                   grids: dict[str, Any] | None = None) -> dict[str, Any]:
+    return {"imports": exp.import_paths(), "store_paths": exp.store_paths,
+            "groups": [_group_payload(exp, c, grids) for c in batch]}
+
+
+# --------------------------------------------------------------------------- the sink
+class _Sink:
+    """Completes worker rows with what the client knows, and writes them."""
+
+    def __init__(self, store: ResultStore, exp: Experiment, runs: Sequence[RunSpec],
+                 summary: SweepSummary, bar: ProgressBar) -> None:
+        self.store = store
+        self.summary = summary
+        self.bar = bar
+        self.specs = {r.key: r for r in runs}
+        self.exp_ids: dict[str, int] = {}
+        self.cfg_ids: dict[tuple[str, str], int] = {}
+        per_cfg: dict[tuple[str, str], int] = {}
+        for r in runs:
+            per_cfg[(r.group, r.config)] = per_cfg.get((r.group, r.config), 0) + 1
+        with store.transaction():
+            for entry in exp.maps:
+                counts = [v for (g, _), v in per_cfg.items() if g == entry.name]
+                setup = canonical_json({k: v for k, v in asdict(entry).items()
+                                        if k != "index"})
+                self.exp_ids[entry.name] = store.ensure_experiment(
+                    exp.name, entry.name, entry.kind,
+                    timelimit=float(exp.limits.time_limit_s or 0.0),
+                    runcount=max(counts) if counts else 0, seed=entry.seeds[0], setup=setup)
+            for r in runs:
+                k = (r.config, r.settings)
+                if k not in self.cfg_ids:
+                    self.cfg_ids[k] = store.ensure_planner_config(r.config, r.planner,
+                                                                  r.settings)
+
+    def complete(self, row: dict[str, Any]) -> dict[str, Any]:
+        r = self.specs[row["run_key"]]
+        out = dict(row)
+        out.update({
+            "experimentid": self.exp_ids[r.group],
+            "plannerid": self.cfg_ids[(r.config, r.settings)],
+            "problem_key": r.problem_key, "kind": r.kind, "map_name": r.group,
+            "planner": r.planner, "seed": r.seed, "query_index": r.query_index,
+            "scen_line": r.query.get("line"), "params": r.payload,
+        })
+        q = r.query
+        if "start" in q and out.get("start_x") is None:
+            out["start_x"], out["start_y"] = q["start"]
+            out["goal_x"], out["goal_y"] = q["goal"]
+        return out
+
+    def write(self, rows: Sequence[dict[str, Any]]) -> None:
+        full = [self.complete(row) for row in rows]
+        self.store.insert_runs(full)
+        errs = 0
+        for row in full:
+            st = row.get("status_name")
+            if st == "ERROR":
+                errs += 1
+                self.summary.errors += 1
+                if str(row.get("error", "")).startswith("WorkerCrashed"):
+                    self.summary.crashed += 1
+                if len(self.summary.error_samples) < 3:
+                    self.summary.error_samples.append(
+                        f"{row['map_name']} seed {row['seed']} {row['planner']}: "
+                        f"{str(row.get('error'))[:200]}")
+            elif row.get("solved"):
+                self.summary.succeeded += 1
+            else:
+                self.summary.failed += 1
+        self.summary.ran += len(full)
+        self.bar.update(len(full), errors=errs)
+
+
+def _crash_row(run: RunSpec) -> dict[str, Any]:
+    return {"run_key": run.key, "status_name": "ERROR", "solved": False, "error": CRASH_TEXT}
+
+
+def _exception_rows(batch: Sequence[Sequence[RunSpec]], exc: BaseException) -> list[dict]:
+    text = f"{type(exc).__name__}: {exc}".strip()
+    return [{"run_key": r.key, "status_name": "ERROR", "solved": False, "error": text}
+            for chunk in batch for r in chunk]
+
+
+# --------------------------------------------------------------------------- backends
+def _run_serial(exp: Experiment, todo: Sequence[RunSpec], sink: _Sink) -> None:
+    for group in iter_groups(todo):
+        gp = _group_payload(exp, group)
+        for r in group:
+            row = execute_run(gp, _run_payload(r), store_paths=exp.store_paths)
+            sink.write([row])
+
+
+def _worker_init(imports: Sequence[str]) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the client handles Ctrl-C
+    ensure_imports(imports)
+
+
+def _mp_context() -> Any:
+    methods = mp.get_all_start_methods()
+    if "forkserver" in methods:
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(["pathfuse", "pathfuse.bench.execute"])
+        return ctx
+    return mp.get_context("spawn")
+
+
+class _Pool:
+    def __init__(self, workers: int, imports: Sequence[str]) -> None:
+        self.ex = ProcessPoolExecutor(max_workers=workers, mp_context=_mp_context(),
+                                      initializer=_worker_init, initargs=(list(imports),))
+
+    def kill(self) -> None:
+        procs = list(getattr(self.ex, "_processes", {}).values())
+        self.ex.shutdown(wait=False, cancel_futures=True)
+        for p in procs:  # only the workers this pool started
+            if p.is_alive():
+                p.terminate()
+        for p in procs:
+            p.join(timeout=5)
+
+
+def _run_pool(exp: Experiment, todo: Sequence[RunSpec], sink: _Sink, workers: int,
+              batch_size: int | None) -> None:
+    imports = exp.import_paths()
+    pending = deque(make_batches(todo, workers, batch_size))
+    pool = _Pool(workers, imports)
+    in_flight: dict[Future, list[list[RunSpec]]] = {}
+    try:
+        while pending or in_flight:
+            while pending and len(in_flight) < 2 * workers:
+                b = pending.popleft()
+                in_flight[pool.ex.submit(execute_batch, _batch_payload(exp, b))] = b
+            done, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
+            broken: list[list[list[RunSpec]]] = []
+            for f in done:
+                b = in_flight.pop(f)
+                try:
+                    rows = f.result()
+                except BrokenProcessPool:
+                    broken.append(b)
+                    continue
+                except Exception as exc:  # noqa: BLE001 - e.g. an unpicklable result
+                    rows = _exception_rows(b, exc)
+                sink.write(rows)
+            if broken:
+                # every other batch in flight fails with the pool; keep those that finished
+                rest = list(in_flight.items())
+                in_flight.clear()
+                wait([f for f, _ in rest], timeout=30)
+                for f, b in rest:
+                    try:
+                        sink.write(f.result(timeout=0))
+                    except Exception:  # noqa: BLE001 - broken or cancelled
+                        broken.append(b)
+                pool.kill()
+                _isolate(exp, [r for b in broken for c in b for r in c], sink, imports)
+                pool = _Pool(workers, imports)
+    finally:
+        pool.kill()
+
+
+def _isolate(exp: Experiment, runs: Sequence[RunSpec], sink: _Sink,
+             imports: Sequence[str]) -> None:
+    """Re-run suspects one by one in a single-worker pool to find the run that crashes."""
+    pool = _Pool(1, imports)
+    try:
+        for r in runs:
+            fut = pool.ex.submit(execute_batch, _batch_payload(exp, [[r]]))
+            try:
+                rows = fut.result()
+            except BrokenProcessPool:
+                rows = [_crash_row(r)]
+                pool.kill()
+                pool = _Pool(1, imports)
+            except Exception as exc:  # noqa: BLE001
+                rows = _exception_rows([[r]], exc)
+            sink.write(rows)
+    finally:
+        pool.kill()
+
+
+def _connect_dask(scheduler: Any) -> tuple[Any, bool]:
+    try:
+        import distributed  # type: ignore[import-not-found]
+    except ImportError:
+        raise ConfigError("scheduler: Dask distributed is not installed; install it with "
+                          "pip install 'pathfuse[dask]'") from None
+    if isinstance(scheduler, distributed.Client):
+        return scheduler, False
+    if not isinstance(scheduler, str) or "://" not in scheduler:
+        raise ConfigError(f"scheduler: expected an address like tcp://HOST:8786, "
+                          f"got {scheduler!r}")
+    try:
+        return distributed.Client(scheduler, timeout="15s", set_as_default=False), True
+    except (OSError, TimeoutError) as exc:
+        raise ConfigError(f"scheduler: cannot connect to {scheduler} ({exc})") from None
+
+
+def _run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: _Sink, scheduler: Any,
+              batch_size: int | None) -> int:
+    from distributed import as_completed  # type: ignore[import-not-found]
+    from distributed.scheduler import KilledWorker  # type: ignore[import-not-found]
+
+    client, own = _connect_dask(scheduler)
+    futures: list[Any] = []
+    try:
+        nworkers = max(1, sum(w.get("nthreads", 1) for w in
+                              client.scheduler_info().get("workers", {}).values()))
+        for imp in exp.import_paths():
+            if imp.endswith(".py"):
+                client.upload_file(imp)
+        # maps read from files are loaded here once and shipped; generated maps are
+        # made on the workers from their spec
+        grids: dict[str, Any] = {}
+        for r in todo:
+            if r.kind == "static" and r.map_key not in grids and r.map_spec and \
+                    any(f in r.map_spec for f in ("movingai", "ros", "image")):
+                grid = load_map(r.map_spec, exp.base_dir)
+                grids[r.map_key] = client.scatter(grid, broadcast=False, hash=True)
+        index: dict[Any, list[list[RunSpec]]] = {}
+        for b in make_batches(todo, nworkers, batch_size):
+            f = client.submit(execute_batch, _batch_payload(exp, b, grids), pure=False)
+            index[f] = b
+            futures.append(f)
+        singles: list[RunSpec] = []
+        for f in as_completed(futures):
+            b = index.pop(f)
+            try:
+                sink.write(f.result())
+            except KilledWorker:
+                singles.extend(r for c in b for r in c)
+            except Exception as exc:  # noqa: BLE001 - stored as the runs' error
+                sink.write(_exception_rows(b, exc))
+        # batches that killed workers: one run per task, so only the culprit fails
+        if singles:
+            index = {}
+            fs = []
+            for r in singles:
+                f = client.submit(execute_batch, _batch_payload(exp, [[r]], grids),
+                                  pure=False)
+                index[f] = r
+                fs.append(f)
+            futures.extend(fs)
+            for f in as_completed(fs):
+                r = index.pop(f)
+                try:
+                    sink.write(f.result())
+                except KilledWorker:
+                    sink.write([_crash_row(r)])
+                except Exception as exc:  # noqa: BLE001
+                    sink.write(_exception_rows([[r]], exc))
+        return nworkers
+    finally:
+        try:
+            client.cancel(futures)
+        except Exception:  # noqa: BLE001 - the cluster may be gone
+            pass
+        if own:
+            client.close()
+
+
+# --------------------------------------------------------------------------- entry point
+def run_bench(
+    experiment_path: str | os.PathLike[str],
+    db_path: str | os.PathLike[str],
+    seeds: Any = None,
+    workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool | None = True,
+    *,
+    retry_errors: bool = False,
+    batch_size: int | None = None,
+    stream: Any = None,
+    on_start: Callable[[int, int], None] | None = None,
+) -> SweepSummary:
+    """Run (or resume) the sweep of an experiment file into a result database.
+
+    Parameters
+    ----------
+    experiment_path : path-like
+        The experiment YAML (see :mod:`pathfuse.bench.experiment`).
+    db_path : path-like
+        The study's SQLite database; created if missing, resumed if not.
+    seeds : optional
+        Override every seed list of the file: a count, a list, ``"A:B"``.
+    workers : int, optional
+        Local worker processes (default: all usable CPUs; 1 runs in-process).
+    scheduler : str, optional
+        ``"tcp://HOST:PORT"`` of a Dask scheduler (or a ``distributed.Client``);
+        ``workers`` is then ignored.
+    progress : bool or None
+        Show a progress bar on stderr (None: only when stderr is a terminal).
+    retry_errors : bool
+        Run again the runs stored as ``ERROR`` (their rows are replaced).
+    batch_size : int, optional
+        Runs per task (default: about eight tasks per worker, at most 64).
+    stream : file, optional
+        Where the progress bar writes (default ``sys.stderr``).
+    on_start : callable, optional
+        Called with ``(total, to_run)`` once the run list is known.
+
+    Returns
+    -------
+    SweepSummary
+
+    Raises
+    ------
+    ConfigError
+        A bad experiment file, ``workers``, ``scheduler`` or database (one line
+        naming the key).
+    SweepInterrupted
+        Ctrl-C; everything finished before it is stored.
+    """
+    t0 = time.perf_counter()
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise ConfigError(f"workers: must be an integer >= 1, got {workers!r}")
+    if batch_size is not None and (isinstance(batch_size, bool)
+                                   or not isinstance(batch_size, int) or batch_size < 1):
+        raise ConfigError(f"batch_size: must be an integer >= 1, got {batch_size!r}")
+    exp = load_experiment(experiment_path, seeds=seeds)
+    runs = exp.expand()
+    nworkers = default_workers() if workers is None else workers
+    if scheduler is not None:
+        _connect_check(scheduler)
+    store = ResultStore(db_path)
+    summary = SweepSummary(experiment=exp.name, db_path=str(db_path), total=len(runs),
+                           workers=nworkers,
+                           scheduler=_scheduler_name(scheduler))
+    try:
+        done = store.done_keys(include_errors=not retry_errors)
+        todo = [r for r in runs if r.key not in done]
+        summary.skipped = len(runs) - len(todo)
+        if on_start is not None:
+            on_start(len(runs), len(todo))
+        session = store.start_session(
+            study=exp.name, experiment_file=str(Path(experiment_path)),
+            experiment_sha256=file_digest(Path(experiment_path)),
+            experiment_text=exp.text, workers=nworkers, scheduler=summary.scheduler,
+            planned=len(runs), skipped=summary.skipped)
+        enabled = bool(progress) if progress is not None else bool(
+            getattr(stream or sys.stderr, "isatty", lambda: False)())
+        bar = ProgressBar(len(todo), label=exp.name, stream=stream, enabled=enabled and
+                          bool(todo))
+        sink = _Sink(store, exp, runs, summary, bar)
+        state = "failed"
+        try:
+            if not todo:
+                pass
+            elif scheduler is not None:
+                summary.workers = _run_dask(exp, todo, sink, scheduler, batch_size)
+            elif nworkers == 1 or len(todo) == 1:
+                _run_serial(exp, todo, sink)
+            else:
+                _run_pool(exp, todo, sink, nworkers, batch_size)
+            state = "finished"
+        except KeyboardInterrupt:
+            state = "interrupted"
+            summary.interrupted = True
+            raise SweepInterrupted(summary) from None
+        finally:
+            bar.close()
+            summary.wall_s = time.perf_counter() - t0
+            try:
+                store.update_totals()
+                store.end_session(session, state=state, ran=summary.ran,
+                                  errors=summary.errors)
+            except Exception:  # noqa: BLE001 - never mask the original error
+                pass
+    finally:
+        store.close()
+    return summary
+
+
+def _scheduler_name(scheduler: Any) -> str | None:
+    if scheduler is None or isinstance(scheduler, str):
+        return scheduler
+    try:
+        return str(scheduler.scheduler.address)
+    except AttributeError:
+        return repr(scheduler)
+
+
+def _connect_check(scheduler: Any) -> None:
+    """Fail early (before touching the database) on a bad scheduler value."""
+    if isinstance(scheduler, str):
+        if "://" not in scheduler:
+            raise ConfigError(f"scheduler: expected an address like tcp://HOST:8786, "
+                              f"got {scheduler!r}")
+        try:
+            import distributed  # type: ignore[import-not-found]  # noqa: F401
+        except ImportError:
+            raise ConfigError("scheduler: Dask distributed is not installed; install it "
+                              "with pip install 'pathfuse[dask]'") from None

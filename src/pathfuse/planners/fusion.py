@@ -1,0 +1,309 @@
+"""The A*-APF fusion planner (paper Section III.C, Algorithm 2), registered as ``"fusion"``.
+
+Step 1 plans a global path with grid A* (Euclidean heuristic, no corner
+cutting, on the map grown by ``robot_radius_m``); if A* fails its status is
+returned.  Step 2 starts the robot at ``start`` and repeats, until the goal is
+reached:
+
+* every A* path point strictly inside the circle of radius ``r1_m`` around
+  the robot that lies *ahead* attracts it (eq. 5), summed with the goal's
+  attraction (eq. 9);
+* every occupied cell centre closer than ``r2_m`` repels it (eq. 6, zero
+  beyond ``rho0_m``);
+* the robot makes one safe step along the resultant
+  (:func:`pathfuse.field.stepper.safe_step`: never into or across an
+  occupied cell grown by ``robot_radius_m``).
+
+"Ahead" (``ahead``):
+
+``"progress"`` (default)
+    path points after the robot's progress index, the nearest path point
+    within reach, which only moves forward
+    (:func:`pathfuse.field.stepper.advance_progress`).  It does not depend on
+    the direction of travel, so the planner gives the same path on a rotated
+    or mirrored map.
+``"paper-x"``
+    the paper's eq. 8, ``x_p - x_current > 0``.  It assumes the goal lies
+    towards +x; on other maps the path points behind in x are ignored even
+    when they lie ahead along the path.
+
+Local-minimum escape (``escape=True``, default).  The goal's attraction is
+usually much larger than that of the few path points inside ``r1``
+(K_att |X - X_g| against K_att |X - P|), so the robot heads for the goal,
+slides along obstacles on the way, and can stall where the A* path turns
+around a cluster.  When it stalls (net move below ``stall_distance_m`` over
+``stall_steps`` steps) or is blocked, it backs off along its own walk: among
+the walked points and the A* points within ``r1_m + resolution`` of them with
+a clear straight move between the two, it picks the pair that makes "walk to
+there, go straight to the A* point, follow the A* path to the goal" shortest;
+the walk after that point is dropped from the returned path
+(``info["backoff_steps"]`` counts the dropped steps).  It goes straight to the
+A* point, then follows the A* path point by point until it is
+``escape_points`` points past its progress at the stall; then Algorithm 2
+resumes.  Every move is checked for collision, each escape moves the progress
+index forward, and the start (the first walked point) sees the first A*
+point, so escapes end.  With
+``escape=False`` the planner is the paper's as printed and a stall ends the
+plan with ``LOCAL_MINIMUM``.
+
+Result: ``time_s`` includes A*; ``info`` holds ``astar_path``,
+``astar_time_s``, ``astar_length``, ``escapes`` (count), ``backoff_steps``,
+``step_time_s``,
+``steps_per_s``, ``step_m`` and ``goal_tolerance_m``.  Other statuses as in
+:mod:`pathfuse.planners.apf`.
+
+Examples
+--------
+>>> from pathfuse.grid import GridMap
+>>> from pathfuse import plan
+>>> g = GridMap.from_rows(["......", "..##..", "......", "......"])
+>>> r = plan(g, (0.5, 0.5), (4.5, 3.5), planner="fusion")
+>>> r.status.name, r.path[-1].tolist(), r.length < r.info["astar_length"] + 1.0
+('SUCCESS', [4.5, 3.5], True)
+>>> plan(g, (0.5, 0.5), (4.5, 3.5), planner="fusion", ahead="behind")
+Traceback (most recent call last):
+...
+pathfuse.result.ConfigError: ahead must be one of 'progress', 'paper-x', got 'behind'
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from pathfuse.field.driver import (
+    check_int,
+    check_nonneg,
+    check_positive,
+    drive,
+    failure_message,
+    resolve_stepping,
+)
+from pathfuse.field.forces import K_ATT, K_REP, RHO0_M
+from pathfuse.field.stepper import (
+    AHEAD_PAPER_X,
+    AHEAD_PROGRESS,
+    N_S,
+    S_BACKOFF,
+    S_ESCAPES,
+    fusion_force,
+    fusion_run,
+    pack_fusion,
+)
+from pathfuse.grid import GridMap
+from pathfuse.planners.registry import PlannerSpec, get_planner, register
+from pathfuse.result import Budget, ConfigError, PlanResult, Status, path_length
+
+__all__ = ["FusionParams", "plan_fusion", "follow_global_path", "force_at", "warmup"]
+
+_AHEAD = {"progress": AHEAD_PROGRESS, "paper-x": AHEAD_PAPER_X}
+
+
+@dataclass(frozen=True)
+class FusionParams:
+    """Parameters of the fusion planner (paper values for K_att, K_rep, rho_0).
+
+    Attributes
+    ----------
+    k_att, k_rep, rho0_m, step_m, goal_tolerance_m, robot_radius_m, stall_steps, stall_distance_m
+        As in :class:`pathfuse.planners.apf.APFParams`.
+    r1_m : float
+        Radius of the circle (eq. 7) inside which A* path points attract the
+        robot, metres.  The paper gives no value; 1.5 m (1.5 cells on the
+        paper map) takes in the next one or two A* points.
+    r2_m : float
+        Radius inside which obstacle points repel, metres.  Repulsion (eq. 6)
+        is zero beyond ``rho0_m`` anyway, so the default equals ``rho0_m``
+        (2 m) and larger values change nothing.
+    ahead : {"progress", "paper-x"}
+        Which path points count as ahead (see the module docstring).
+    escape : bool
+        Enable the local-minimum escape along the A* path.
+    escape_points : int
+        Path points to advance in escape mode before Algorithm 2 resumes.
+    """
+
+    k_att: float = K_ATT
+    k_rep: float = K_REP
+    rho0_m: float = RHO0_M
+    r1_m: float = 1.5
+    r2_m: float = RHO0_M
+    ahead: str = "progress"
+    step_m: float | None = None
+    goal_tolerance_m: float | None = None
+    robot_radius_m: float = 0.0
+    stall_steps: int = 40
+    stall_distance_m: float | None = None
+    escape: bool = True
+    escape_points: int = 3
+
+    def __post_init__(self) -> None:
+        check_positive("k_att", self.k_att)
+        check_nonneg("k_rep", self.k_rep)
+        check_positive("rho0_m", self.rho0_m)
+        check_positive("r1_m", self.r1_m)
+        check_positive("r2_m", self.r2_m)
+        if self.ahead not in _AHEAD:
+            raise ConfigError(
+                f"ahead must be one of {', '.join(repr(a) for a in _AHEAD)}, got {self.ahead!r}"
+            )
+        check_positive("step_m", self.step_m, optional=True)
+        check_positive("goal_tolerance_m", self.goal_tolerance_m, optional=True)
+        check_nonneg("robot_radius_m", self.robot_radius_m)
+        check_int("stall_steps", self.stall_steps, 1)
+        check_positive("stall_distance_m", self.stall_distance_m, optional=True)
+        if not isinstance(self.escape, (bool, np.bool_)):
+            raise ConfigError(f"escape must be true or false, got {self.escape!r}")
+        check_int("escape_points", self.escape_points, 1)
+
+
+def _cumlen(pts: np.ndarray) -> np.ndarray:
+    cum = np.zeros(pts.shape[0])
+    if pts.shape[0] > 1:
+        cum[1:] = np.cumsum(np.hypot(*np.diff(pts, axis=0).T))
+    return cum
+
+
+def force_at(
+    grid: GridMap,
+    xy: object,
+    goal: object,
+    global_path: object,
+    params: FusionParams | None = None,
+    progress: int = 0,
+) -> np.ndarray:
+    """The resultant force of Algorithm 2 at ``xy`` (2,) given the global path.
+
+    ``progress`` is the robot's progress index along ``global_path`` (used by
+    ``ahead="progress"``).  Returns ``[fx, fy]``.
+
+    >>> g = GridMap.from_rows(["....", "....", "...."])
+    >>> path = [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 0.5]]
+    >>> force_at(g, (0.5, 0.5), (3.5, 0.5), path, FusionParams(r1_m=1.5)).tolist()
+    [160.0, 0.0]
+    """
+    p = params or FusionParams()
+    pts = np.ascontiguousarray(global_path, dtype=np.float64).reshape(-1, 2)
+    x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(2))
+    gx, gy = (float(v) for v in np.asarray(goal, dtype=np.float64).reshape(2))
+    ox, oy = grid.origin
+    fx, fy, _ = fusion_force(x, y, gx, gy, pts, _cumlen(pts), int(progress), _AHEAD[p.ahead],
+                             p.k_att, p.k_rep, p.rho0_m, p.r1_m, p.r2_m, grid.occupied, ox, oy,
+                             grid.resolution)
+    return np.array([fx, fy])
+
+
+def follow_global_path(
+    grid: GridMap,
+    start: np.ndarray,
+    goal: np.ndarray,
+    global_path: np.ndarray,
+    params: FusionParams | None = None,
+    budget: Budget | None = None,
+    t0: float | None = None,
+) -> PlanResult:
+    """Step 2 of the fusion planner alone: follow ``global_path`` (M, 2) with Algorithm 2.
+
+    ``t0`` is the ``perf_counter`` time the plan started (defaults to now); the
+    wall-clock limit and ``time_s`` count from it.
+    """
+    t0 = time.perf_counter() if t0 is None else t0
+    p = params or FusionParams()
+    budget = budget or Budget()
+    start = np.asarray(start, dtype=np.float64).reshape(2)
+    goal = np.asarray(goal, dtype=np.float64).reshape(2)
+    pts = np.asarray(global_path, dtype=np.float64).reshape(-1, 2)
+    if pts.shape[0] == 0 or not np.array_equal(pts[-1], goal):
+        pts = np.concatenate([pts, goal[None, :]])
+    pts = np.ascontiguousarray(pts)
+    cum = _cumlen(pts)
+    st = resolve_stepping(grid, p.step_m, p.goal_tolerance_m, p.stall_distance_m,
+                          p.robot_radius_m, budget.max_iterations)
+    deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
+    ox, oy = grid.origin
+    fcfg, icfg = pack_fusion(goal, p.k_att, p.k_rep, p.rho0_m, p.r1_m, p.r2_m, st.step_m,
+                             st.goal_tolerance_m, st.clear_m, p.stall_steps, st.stall_distance_m,
+                             ox, oy, grid.resolution, _AHEAD[p.ahead], p.escape,
+                             p.escape_points)
+    state = np.zeros(N_S, dtype=np.int64)
+    occ = grid.occupied
+    out = drive(lambda buf, n, n_stop, k: fusion_run(buf, n, n_stop, k, occ, pts, cum, state,
+                                                     fcfg, icfg),
+                start, st.max_steps, deadline)
+    info = {
+        "escapes": int(state[S_ESCAPES]),
+        "backoff_steps": int(state[S_BACKOFF]),
+        "step_m": st.step_m,
+        "goal_tolerance_m": st.goal_tolerance_m,
+        "step_time_s": out.step_time_s,
+        "steps_per_s": out.steps / out.step_time_s if out.step_time_s > 0 else 0.0,
+    }
+    msg = (f"reached the goal in {out.steps} steps ({int(state[S_ESCAPES])} escapes)"
+           if out.status is Status.SUCCESS else failure_message(out, goal, st, p.stall_steps))
+    return PlanResult(out.status, out.path, path_length(out.path), time.perf_counter() - t0,
+                      "fusion", 0, out.steps, msg, info)
+
+
+def plan_fusion(
+    grid: GridMap,
+    start: np.ndarray,
+    goal: np.ndarray,
+    params: FusionParams | None = None,
+    budget: Budget | None = None,
+) -> PlanResult:
+    """Plan with Algorithm 2: A* (step 1), then the fused potential field (step 2).
+
+    ``Budget.max_iterations`` caps the steps of step 2 (A* runs with the time
+    limit only); ``Budget.time_limit_s`` covers both steps.
+    """
+    from pathfuse.planners.astar import AStarParams, plan_astar
+
+    t0 = time.perf_counter()
+    p = params or FusionParams()
+    budget = budget or Budget()
+    agrid = grid.inflate(p.robot_radius_m) if p.robot_radius_m > 0 else grid
+    ares = plan_astar(agrid, np.asarray(start, dtype=np.float64),
+                      np.asarray(goal, dtype=np.float64), AStarParams(),
+                      Budget(time_limit_s=budget.time_limit_s))
+    t_astar = time.perf_counter() - t0
+    if not ares.success:
+        return PlanResult(ares.status, np.zeros((0, 2)), 0.0, time.perf_counter() - t0,
+                          "fusion", ares.expansions, 0, f"A* failed: {ares.message}",
+                          {"astar_time_s": t_astar, "astar_path": ares.path,
+                           "astar_length": float(ares.length)})
+    res = follow_global_path(grid, start, goal, ares.path, p, budget, t0)
+    res.info.update(astar_path=np.asarray(ares.path), astar_time_s=t_astar,
+                    astar_length=float(ares.length))
+    return PlanResult(res.status, res.path, res.length, time.perf_counter() - t0, "fusion",
+                      ares.expansions, res.iterations, res.message, res.info)
+
+
+def warmup() -> None:
+    """Compile (or load from numba's cache) A* and the fusion kernels on a tiny map."""
+    try:
+        spec = get_planner("astar")
+        if spec.warmup is not None:
+            spec.warmup()
+    except ConfigError:  # pragma: no cover - A* not registered
+        pass
+    g = GridMap.from_rows(["....", ".#..", "...."])
+    s, e = np.array([0.5, 0.5]), np.array([3.5, 2.5])
+    path = np.array([[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]])
+    follow_global_path(g, s, e, path)
+    follow_global_path(g, s, e, path, FusionParams(ahead="paper-x"))
+    force_at(g, s, e, path)
+
+
+register(
+    PlannerSpec(
+        name="fusion",
+        func=plan_fusion,
+        params_cls=FusionParams,
+        description="A*-APF fusion (paper Algorithm 2): APF attracted by the goal and the "
+        "A* path points ahead within r1",
+        uses_astar=True,
+        warmup=warmup,
+    )
+)

@@ -189,8 +189,10 @@ planners: [xsweep]
 
 
 def test_random_queries_and_dynamic_entries(tmp_path):
+    online = pytest.importorskip("pathfuse.world.online")
+    online.register_online(online.OnlinePlannerSpec("xonline", lambda p: None, _Params, "test"))
     (tmp_path / "sc.yaml").write_text("anything: 1\n")
-    exp = load_experiment(write(tmp_path, """
+    text = """
 seeds: 2
 maps:
   - name: r
@@ -198,9 +200,18 @@ maps:
     queries: {random: 3, min_distance_m: 5}
   - name: dyn
     dynamic: sc.yaml
-planners: [xsweep]
-"""))
+planners: %s
+"""
+    with pytest.raises(ConfigError, match=r"maps\[1\]: no planner of this experiment runs "
+                                          r"dynamic maps \(online planners"):
+        load_experiment(write(tmp_path, text % "[xsweep]"))
+    with pytest.raises(ConfigError, match=r"planners\[1\].name: unknown planner 'nope' "
+                                          r"\(choose from static: .*; dynamic: "):
+        load_experiment(write(tmp_path, text % "[xsweep, nope]"))
+    exp = load_experiment(write(tmp_path, text % "[xsweep, xonline]"))
+    assert [p.kinds for p in exp.planners] == [("static",), ("dynamic",)]
     runs = exp.expand()
+    assert {r.planner for r in runs if r.kind == "static"} == {"xsweep"}
     static = [r for r in runs if r.kind == "static"]
     assert len(static) == 2 * 3
     assert [r.query["random"] for r in static] == [0, 1, 2, 0, 1, 2]
@@ -215,7 +226,7 @@ BAD = [
     ("planners:\n  - name: xother\n    params: {r1_m: [0.5, -1]}\nmaps: [paper]\n",
      "planners[0].params.r1_m[1]: "),
     ("planners:\n  - name: xother\n    params: {rr: 1}\nmaps: [paper]\n",
-     "planners[0].params.rr: 'xother' has no such parameter"),
+     "planners[0].params.rr: planner 'xother' has no such parameter"),
     ("planners: [xsweep, {name: nosuch}]\nmaps: [paper]\n", "planners[1].name: unknown planner"),
     ("planners: [xsweep]\nmaps: [paper]\nseeds: -3\n", "seeds: a seed count must be >= 1"),
     ("planners: [xsweep]\nmaps: [paper]\nseeds: [1, x]\n", "seeds[1]: "),

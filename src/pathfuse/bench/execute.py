@@ -17,7 +17,6 @@ The run **kind** selects the executor (:data:`KINDS`): ``"static"`` plans with
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import importlib
 import importlib.util
@@ -394,66 +393,75 @@ def run_static(group: Mapping[str, Any], run: Mapping[str, Any],
 
 
 # --------------------------------------------------------------------------- dynamic runs
+def _scenario(group: Mapping[str, Any]) -> Any:
+    """The group's dynamic scenario, loaded once per process."""
+    from pathfuse.world import load_scenario
+
+    key = (group["map_key"], "scenario")
+    with _LOCK:
+        if key not in _MAPS:
+            _lru_put(_MAPS, key, load_scenario(group["map_spec"]["dynamic"]), _MAP_CACHE_SIZE)
+        return _MAPS[key]
+
+
 def run_dynamic(group: Mapping[str, Any], run: Mapping[str, Any],
                 store_paths: bool) -> dict[str, Any]:
     """One episode in a dynamic world (the ``"dynamic"`` kind).
 
-    SEAM: written against ``pathfuse.world.simulate(scenario, planner=...,
-    seed=..., **params) -> Episode``; the Episode's fields are read by name
-    (status, path, time_s, time_to_goal, collisions, length, ...), so the
-    columns fill in as the world module defines them.
+    Calls :func:`pathfuse.world.simulate` with the online planner, its
+    parameters and the run's seed, and maps the :class:`~pathfuse.world.Episode`
+    to result columns (see :func:`episode_row`).
     """
-    try:
-        from pathfuse import world  # type: ignore[attr-defined]
+    from pathfuse.world import simulate
 
-        simulate = world.simulate
-    except (ImportError, AttributeError):
-        raise RuntimeError("dynamic runs need pathfuse.world.simulate, which this build "
-                           "does not have yet") from None
-    scenario = group["map_spec"]["dynamic"]
     params = dict(run["params"])
-    params.pop("seed", None)
-    kwargs: dict[str, Any] = {"planner": run["planner"], "seed": int(run["seed"])}
-    if params:
-        kwargs["params"] = _plan_params(run["planner"], params)
-    ep = simulate(scenario, **kwargs)
+    choice = {"name": run["planner"], "params": params} if params else run["planner"]
+    ep = simulate(_scenario(group), planner=choice, seed=int(run["seed"]))
     return episode_row(ep, store_paths)
 
 
 def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
-    """Result columns from an Episode-like object (attributes read by name)."""
-    d = dataclasses.asdict(ep) if dataclasses.is_dataclass(ep) else dict(vars(ep))
-    status = d.get("status")
-    name = getattr(status, "name", status)
-    name = str(name).upper() if name is not None else "UNKNOWN"
-    solved = bool(d.get("success", d.get("reached", name == "SUCCESS")))
-    path = d.get("path")
-    path = np.asarray(path, dtype=float).reshape(-1, 2) if path is not None else None
-    length = _num(d.get("length", d.get("length_m")))
-    if length is None and path is not None and path.shape[0] >= 2:
-        length = float(np.hypot(*np.diff(path, axis=0).T).sum())
-    coll = d.get("collisions", d.get("n_collisions"))
-    if isinstance(coll, (list, tuple)):
-        coll = len(coll)
+    """Result columns of an :class:`~pathfuse.world.Episode`.
+
+    ``time`` is the planner's total compute time (``setup_time_s`` plus every
+    tick's ``plan_times_s``); ``time_to_goal`` the simulated time to reach
+    the goal; ``solution_length`` the driven trajectory's length (reached
+    episodes); ``solution_clearance`` the least clearance to any obstacle;
+    ``collisions`` 1 when the episode ended in a collision.
+    """
+    status = ep.status
+    name = str(getattr(status, "name", status)).upper()
+    solved = bool(getattr(ep, "reached", name == "REACHED"))
+    d = ep.to_dict(trajectories=False) if hasattr(ep, "to_dict") else {}
+    plan_times = np.asarray(getattr(ep, "plan_times_s", ()), dtype=float)
+    compute = float(getattr(ep, "setup_time_s", 0.0)) + float(plan_times.sum())
+    coll = getattr(ep, "collision_with", None)
+    positions = np.asarray(getattr(ep, "positions", np.zeros((0, 2))), dtype=float)
+    sc = getattr(ep, "scenario", None)
     row: dict[str, Any] = {
         "status_name": name,
         "solved": solved,
-        "time": _num(d.get("time_s", d.get("planning_time_s", d.get("compute_time_s")))),
-        "solution_length": length if solved else None,
-        "time_to_goal": _num(d.get("time_to_goal", d.get("time_to_goal_s")))
-        if solved else None,
-        "collisions": None if coll is None else int(coll),
-        "collision_free": None if coll is None else int(coll) == 0,
-        "iterations": int(d.get("steps", d.get("iterations", 0)) or 0),
-        "steps": None if d.get("steps") is None else int(d["steps"]),
-        "message": str(d.get("message", "")),
-        "solution_clearance": _num(d.get("min_clearance_m", d.get("min_clearance"))),
-        "metrics": json.dumps(_scalars(d), sort_keys=True),
+        "time": compute,
+        "solution_length": _num(getattr(ep, "path_length_m", None)) if solved else None,
+        "time_to_goal": _num(getattr(ep, "time_to_goal_s", None)) if solved else None,
+        "collisions": 0 if coll is None else 1,
+        "collision_free": coll is None,
+        "iterations": int(getattr(ep, "n_ticks", 0)),
+        "steps": int(getattr(ep, "n_ticks", 0)),
+        "solution_segments": max(0, positions.shape[0] - 1) if solved else None,
+        "solution_clearance": _num(getattr(ep, "min_distance_m", None)),
+        "message": str(getattr(ep, "message", "")),
     }
-    if path is not None and path.shape[0]:
-        row["start_x"], row["start_y"] = map(float, path[0])
-        if store_paths:
-            row["path"] = _path_blob(path)
+    if sc is not None:
+        row["start_x"], row["start_y"] = (float(c) for c in sc.start)
+        row["goal_x"], row["goal_y"] = (float(c) for c in sc.goal)
+    sc_d = {k: v for k, v in d.items() if k not in ("params", "scenario", "planner")}
+    timing = {k: v for k, v in _scalars(sc_d).items() if _is_timing(k) and "to_goal" not in k}
+    row["metrics"] = json.dumps({k: v for k, v in _scalars(sc_d).items() if k not in timing},
+                                sort_keys=True)
+    row["timing"] = json.dumps(timing, sort_keys=True)
+    if store_paths and positions.shape[0]:
+        row["path"] = _path_blob(positions)
     return row
 
 

@@ -42,9 +42,12 @@ File layout
         label: fusion                # optional name in reports (default: name + swept values)
         params: {r1: [0.5, 1, 1.5, 2], r2: [1, 2], step: 0.5}   # lists are swept
         limits: {time_limit_s: 2}    # per-planner override
+        kinds: [static]              # optional: only static maps (or dynamic)
 
-A list value in ``params`` is a grid axis; the runs take the cartesian product
-of all axes, in the order the keys are written.  To give a parameter a list
+A planner runs on the static maps when its name is a :func:`pathfuse.plan`
+planner and on the dynamic entries when it is an online planner of
+:mod:`pathfuse.world` (``kinds`` restricts this).  A list value in
+``params`` is a grid axis; the runs take the cartesian product of all axes, in the order the keys are written.  To give a parameter a list
 *value*, wrap it: ``[[1, 2]]``.  Relative paths are relative to the
 experiment file.  For generated maps (``paper``, ``random``) without an
 explicit ``seed`` the run's seed is the map's seed.
@@ -126,7 +129,7 @@ _TOP_KEYS = ("name", "description", "seeds", "limits", "robot_radius_m", "refere
              "store_paths", "imports", "maps", "planners")
 _MAP_KEYS = ("name", "map", "start", "goal", "queries", "scen", "lines", "seeds",
              "robot_radius_m", "dynamic")
-_PLANNER_KEYS = ("name", "label", "params", "limits")
+_PLANNER_KEYS = ("name", "label", "params", "limits", "kinds")
 _LIMIT_KEYS = ("time_limit_s", "max_iterations")
 
 
@@ -297,7 +300,12 @@ def _parse_limits(value: Any, where: str, base: Limits | None = None) -> Limits:
 
 @dataclass(frozen=True)
 class PlannerEntry:
-    """One ``planners[i]`` entry: a registry name, fixed params and swept axes."""
+    """One ``planners[i]`` entry: a registry name, fixed params and swept axes.
+
+    ``kinds`` are the run kinds it applies to: ``static`` when the name is in
+    :mod:`pathfuse.planners.registry`, ``dynamic`` when it is an online planner
+    of :mod:`pathfuse.world` (and the experiment has such maps).
+    """
 
     index: int
     name: str
@@ -305,8 +313,9 @@ class PlannerEntry:
     params: tuple[tuple[str, tuple[Any, ...]], ...]
     """(key, values) in file order; a fixed parameter has one value."""
     limits: Limits
-    param_fields: tuple[str, ...] = ()
-    defaults: dict[str, Any] = field(default_factory=dict)
+    kinds: tuple[str, ...] = ("static",)
+    fields_by_kind: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    defaults_by_kind: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     @property
     def swept(self) -> tuple[str, ...]:
@@ -459,6 +468,7 @@ class Experiment:
         seen: dict[str, tuple[int, int]] = {}
         combos = [(p, p.combinations()) for p in self.planners]
         for entry in self.maps:
+            applicable = [(p, c) for p, c in combos if entry.kind in p.kinds]
             for seed in entry.seeds:
                 map_portable, map_load, map_key = self._map_identity(entry, seed)
                 for qi, query in enumerate(self._queries(entry, seed)):
@@ -466,13 +476,14 @@ class Experiment:
                                "map": map_portable, "query": query,
                                "robot_radius_m": entry.robot_radius_m}
                     problem_key = run_key(problem)[:24]
-                    for pe, pcombos in combos:
+                    for pe, pcombos in applicable:
+                        defaults = pe.defaults_by_kind[entry.kind]
                         for combo in pcombos:
                             params = dict(combo)
-                            settings = canonical_json({**pe.defaults, **combo})
-                            if "seed" in pe.param_fields and "seed" not in params:
+                            settings = canonical_json({**defaults, **combo})
+                            if "seed" in pe.fields_by_kind[entry.kind] and "seed" not in params:
                                 params["seed"] = int(seed)
-                            full = {**pe.defaults, **params}
+                            full = {**defaults, **params}
                             limits = pe.limits.as_dict()
                             reference = self.reference if entry.kind == "static" else None
                             payload = canonical_json({
@@ -738,11 +749,6 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
                 raise ConfigError(f"imports[{i}]: no such file {ip}")
     _do_imports(imports, exp_dir)
 
-    raw_planners = doc.get("planners")
-    if not isinstance(raw_planners, list) or not raw_planners:
-        raise ConfigError("planners: must be a non-empty list of planners")
-    planners = tuple(_parse_planner(i, v, limits) for i, v in enumerate(raw_planners))
-
     if "reference" in doc:
         reference = _parse_reference(doc["reference"])
     else:  # default: A* (when this build has it)
@@ -763,6 +769,18 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
                               f"maps[{names[entry.name]}]")
         names[entry.name] = i
         maps.append(entry)
+    kinds = tuple(k for k in ("static", "dynamic") if any(m.kind == k for m in maps))
+    raw_planners = doc.get("planners")
+    if not isinstance(raw_planners, list) or not raw_planners:
+        raise ConfigError("planners: must be a non-empty list of planners")
+    planners = tuple(_parse_planner(i, v, limits, kinds) for i, v in enumerate(raw_planners))
+    for m in maps:
+        if not any(m.kind in p.kinds for p in planners):
+            raise ConfigError(f"maps[{m.index}]: no planner of this experiment runs "
+                              f"{m.kind} maps (" + ("online planners of pathfuse.world: "
+                              + ", ".join(_registry("dynamic").names()) if m.kind == "dynamic"
+                              else "planners: " + ", ".join(_registry("static").names()))
+                              + ")")
     exp = Experiment(path=path, name=name.strip(), description=desc, text=text,
                      seeds=top_seeds, limits=limits, robot_radius_m=radius,
                      reference=reference, store_paths=store_paths,
@@ -811,9 +829,43 @@ def _parse_reference(v: Any) -> dict[str, Any] | None:
     return {"planner": spec.name, "params": _plain(dict(v.get("params") or {}))}
 
 
-def _parse_planner(i: int, v: Any, top_limits: Limits) -> PlannerEntry:
-    from pathfuse.planners.registry import get_planner, make_params
+class _Registry:
+    """The planner registry of one run kind (static planners or online planners)."""
 
+    def __init__(self, kind: str) -> None:
+        self.kind = kind
+        if kind == "static":
+            from pathfuse.planners import registry as reg
+
+            self._names, self._get, self._make = reg.planner_names, reg.get_planner, \
+                reg.make_params
+        else:
+            from pathfuse.world import online
+
+            self._names, self._get = online.online_planner_names, online.get_online_planner
+            self._make = lambda spec, params: online.make_online_params(spec, params)
+
+    def names(self) -> list[str]:
+        return list(self._names())
+
+    def get(self, name: Any) -> Any:
+        return self._get(name)
+
+    def make(self, spec: Any, params: Mapping[str, Any]) -> Any:
+        return self._make(spec, dict(params))
+
+
+_REGISTRIES: dict[str, _Registry] = {}
+
+
+def _registry(kind: str) -> _Registry:
+    if kind not in _REGISTRIES:
+        _REGISTRIES[kind] = _Registry(kind)
+    return _REGISTRIES[kind]
+
+
+def _parse_planner(i: int, v: Any, top_limits: Limits,
+                   kinds: Sequence[str] = ("static",)) -> PlannerEntry:
     where = f"planners[{i}]"
     if isinstance(v, str):
         v = {"name": v}
@@ -826,10 +878,28 @@ def _parse_planner(i: int, v: Any, top_limits: Limits) -> PlannerEntry:
                               f"{', '.join(_PLANNER_KEYS)}")
     if "name" not in v:
         raise ConfigError(f"{where}.name: missing (the planner's registry name)")
-    try:
-        spec = get_planner(v["name"])
-    except ConfigError as exc:
-        raise ConfigError(f"{where}.name: {exc}") from None
+    name = v["name"]
+    if "kinds" in v:
+        want = v["kinds"]
+        want = [want] if isinstance(want, str) else want
+        if not isinstance(want, list) or not want or \
+                not set(want) <= {"static", "dynamic"}:
+            raise ConfigError(f"{where}.kinds: expected a list of static / dynamic, "
+                              f"got {_short(v['kinds'])}")
+        kinds = [k for k in kinds if k in want]
+    specs: dict[str, Any] = {}
+    for kind in kinds:
+        reg = _registry(kind)
+        if isinstance(name, str) and name in reg.names():
+            specs[kind] = reg.get(name)
+    if not specs:
+        if len(kinds) == 1 or not kinds:
+            try:
+                _registry(kinds[0] if kinds else "static").get(name)
+            except ConfigError as exc:
+                raise ConfigError(f"{where}.name: {exc}") from None
+        choices = "; ".join(f"{k}: {', '.join(_registry(k).names())}" for k in kinds)
+        raise ConfigError(f"{where}.name: unknown planner {name!r} (choose from {choices})")
     label = v.get("label")
     if label is not None and (not isinstance(label, str) or not label.strip()):
         raise ConfigError(f"{where}.label: must be a non-empty string, got {label!r}")
@@ -837,45 +907,58 @@ def _parse_planner(i: int, v: Any, top_limits: Limits) -> PlannerEntry:
     if not isinstance(raw, Mapping):
         raise ConfigError(f"{where}.params: expected a mapping of parameter: value or "
                           f"[values], got {_short(raw)}")
-    fields = tuple(f.name for f in dataclasses.fields(spec.params_cls))
-    types = {f.name: f.type for f in dataclasses.fields(spec.params_cls)}
-    defaults = _plain(spec.defaults())
-    raw_defaults = spec.defaults()
+    fields_by_kind = {k: tuple(f.name for f in dataclasses.fields(sp.params_cls))
+                      for k, sp in specs.items()}
+    types: dict[str, Any] = {}
+    raw_defaults: dict[str, Any] = {}
+    for sp in specs.values():
+        types.update({f.name: f.type for f in dataclasses.fields(sp.params_cls)})
+        raw_defaults.update(sp.defaults())
     params: list[tuple[str, tuple[Any, ...]]] = []
     for k, val in raw.items():
         kw = f"{where}.params.{k}"
-        if k not in fields:
-            raise ConfigError(f"{kw}: {spec.name!r} has no such parameter; its parameters "
-                              f"are: {', '.join(sorted(fields))}")
+        for kind, sp in specs.items():
+            if k not in fields_by_kind[kind]:
+                what = "online planner" if kind == "dynamic" else "planner"
+                raise ConfigError(f"{kw}: {what} {sp.name!r} has no such parameter; its "
+                                  f"parameters are: {', '.join(sorted(fields_by_kind[kind]))}")
         values = list(val) if isinstance(val, list) else [val]
         if not values:
             raise ConfigError(f"{kw}: the list of values is empty")
         vals = tuple(_coerce_param(x, raw_defaults.get(k), types.get(k)) for x in values)
         for j, x in enumerate(vals):
-            try:
-                make_params(spec, {k: x})
-            except ConfigError as exc:
-                idx = f"[{j}]" if isinstance(val, list) else ""
-                raise ConfigError(f"{kw}{idx}: {_strip_planner(str(exc))}") from None
+            for kind, sp in specs.items():
+                try:
+                    _registry(kind).make(sp, {k: x})
+                except ConfigError as exc:
+                    idx = f"[{j}]" if isinstance(val, list) else ""
+                    raise ConfigError(f"{kw}{idx}: {_strip_planner(str(exc))}") from None
         if len(set(map(canonical_json, vals))) != len(vals):
             raise ConfigError(f"{kw}: the list of values repeats a value")
         params.append((str(k), tuple(_plain(list(vals)))))
-    pe = PlannerEntry(index=i, name=spec.name, label=label.strip() if label else None,
-                      params=tuple(params), limits=_parse_limits(v.get("limits"),
-                                                                 f"{where}.limits", top_limits),
-                      param_fields=fields, defaults=defaults)
-    for combo in pe.combinations():  # cross-parameter checks of the dataclass
-        try:
-            make_params(spec, {k: _coerce_param(x, raw_defaults.get(k), types.get(k))
-                               for k, x in combo.items()})
-        except ConfigError as exc:
-            raise ConfigError(f"{where}.params: {_strip_planner(str(exc))} "
-                              f"(combination {canonical_json(combo)})") from None
-    return pe
+    entry = PlannerEntry(
+        index=i, name=name, label=label.strip() if label else None, params=tuple(params),
+        limits=_parse_limits(v.get("limits"), f"{where}.limits", top_limits),
+        kinds=tuple(specs), fields_by_kind=fields_by_kind,
+        defaults_by_kind={k: _plain(sp.defaults()) for k, sp in specs.items()})
+    for combo in entry.combinations():  # cross-parameter checks of the dataclass
+        for kind, sp in specs.items():
+            try:
+                _registry(kind).make(sp, {k: _coerce_param(x, raw_defaults.get(k),
+                                                           types.get(k))
+                                          for k, x in combo.items()})
+            except ConfigError as exc:
+                raise ConfigError(f"{where}.params: {_strip_planner(str(exc))} "
+                                  f"(combination {canonical_json(combo)})") from None
+    return entry
 
 
 def _strip_planner(msg: str) -> str:
-    return msg.split(": ", 1)[1] if msg.startswith("planner '") else msg
+    if msg.startswith("planner '"):
+        return msg.split(": ", 1)[1]
+    if msg.startswith("params."):  # online planners name the key themselves
+        return msg.split(": ", 1)[1] if ": " in msg else msg
+    return msg
 
 
 def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,

@@ -49,8 +49,9 @@ planner and on the dynamic entries when it is an online planner of
 :mod:`pathfuse.world` (``kinds`` restricts this).  A list value in
 ``params`` is a grid axis; the runs take the cartesian product of all axes,
 in the order the keys are written.  To give a parameter a list *value*, wrap
-it: ``[[1, 2]]``.  Relative paths are relative to the experiment file.  For generated maps (``paper``, ``random``) without an
-explicit ``seed`` the run's seed is the map's seed.
+it: ``[[1, 2]]``.  Relative paths are relative to the experiment file.  For
+generated maps (``paper``, ``random``) without an explicit ``seed`` the
+run's seed is the map's seed.
 
 Run order: maps (file order) > seeds > queries > planners (file order) >
 parameter combinations (cartesian product, first key outermost).

@@ -68,7 +68,7 @@ Examples
 ...     start: [0.5, 0.5]
 ...     goal: [3.5, 2.5]
 ... planners:
-...   - name: astar
+...   - name: apf
 ... '''
 >>> with tempfile.TemporaryDirectory() as d:
 ...     p = pathlib.Path(d) / "demo.yaml"

@@ -91,7 +91,8 @@ Examples
 ...         st.insert_runs([{"run_key": "k1", "experimentid": e, "plannerid": p,
 ...                          "status_name": "SUCCESS", "solved": True, "time": 0.01,
 ...                          "solution_length": 14.14}])
-...         sorted(st.done_keys()), st.count()
+...         done, n = sorted(st.done_keys()), st.count()
+>>> done, n
 (['k1'], 1)
 """
 

@@ -88,12 +88,12 @@ Examples
 ...     with ResultStore(os.path.join(d, "s.db")) as st:
 ...         e = st.ensure_experiment("study", "paper", "static", runcount=2)
 ...         p = st.ensure_planner_config("astar", "astar", "{}")
-...         st.insert_runs([{"run_key": "k1", "experimentid": e, "plannerid": p,
+...         n = st.insert_runs([{"run_key": "k1", "experimentid": e, "plannerid": p,
 ...                          "status_name": "SUCCESS", "solved": True, "time": 0.01,
 ...                          "solution_length": 14.14}])
-...         done, n = sorted(st.done_keys()), st.count()
->>> done, n
-(['k1'], 1)
+...         done, count = sorted(st.done_keys()), st.count()
+>>> n, done, count
+(1, ['k1'], 1)
 """
 
 from __future__ import annotations

@@ -106,7 +106,7 @@ def repulsive_potential(
     0.625
     """
     diff = _xy(x) - _xy(obstacle)
-    d = np.sqrt(np.sum(diff * diff, axis=-1))
+    d = np.hypot(diff[..., 0], diff[..., 1])
     dc = np.maximum(d, D_MIN_M)
     u = 0.5 * k_rep * (1.0 / dc - 1.0 / rho0_m) ** 2
     return np.where(d <= rho0_m, u, 0.0)
@@ -124,7 +124,7 @@ def repulsive_force(
     [0.0, 30.0]
     """
     diff = _xy(x) - _xy(obstacle)
-    d = np.sqrt(np.sum(diff * diff, axis=-1))
+    d = np.hypot(diff[..., 0], diff[..., 1])
     dc = np.maximum(d, D_MIN_M)
     mag = k_rep * (1.0 / dc - 1.0 / rho0_m) / (dc * dc)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -167,7 +167,7 @@ def att_force_xy(x: float, y: float, px: float, py: float, k_att: float) -> tupl
 @njit(cache=True, inline="always")
 def rep_force_xy(dx: float, dy: float, k_rep: float, rho0_m: float) -> tuple[float, float]:
     """Scalar eq. 6 for the offset ``(dx, dy) = X - X_o`` of the robot from one obstacle point."""
-    d = math.sqrt(dx * dx + dy * dy)
+    d = math.hypot(dx, dy)
     if d > rho0_m or d == 0.0:
         return 0.0, 0.0
     dc = d if d > D_MIN_M else D_MIN_M

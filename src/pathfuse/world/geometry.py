@@ -187,9 +187,18 @@ def disc_sweep_gaps(p0: np.ndarray, p1: np.ndarray, radius: float, q0: np.ndarra
 
 
 def warmup_geometry() -> None:
-    """Compile (or load from numba's cache) the kernels of this module."""
-    occ = np.zeros((2, 2), dtype=np.bool_)
-    occ[0, 0] = True
-    segment_static_distance(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.6, 1.2, 1.0)
-    z = np.zeros(2)
-    disc_sweep_gaps(z, z, 0.1, np.zeros((1, 2)), np.zeros((1, 2)), np.ones(1))
+    """Compile (or load from numba's cache) the kernels of this module.
+
+    Both writeable and read-only arrays are used (``GridMap.occupied`` and the
+    precomputed obstacle trajectories are read-only, a distinct numba type).
+    """
+    for ro in (False, True):
+        occ = np.zeros((2, 2), dtype=np.bool_)
+        occ[0, 0] = True
+        q = np.zeros((1, 2))
+        occ.setflags(write=not ro)
+        q.setflags(write=not ro)
+        segment_static_distance(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.6, 1.2, 1.0)
+        z = np.zeros(2)
+        disc_sweep_gaps(z, z, 0.1, q, q, np.ones(1))
+        disc_sweep_gaps(z, z, 0.1, q, np.zeros((1, 2)), np.ones(1))

@@ -364,7 +364,9 @@ def obstacle_trajectories(obstacles: tuple[ObstacleSpec, ...] | list[ObstacleSpe
 
 
 def warmup_obstacles() -> None:
-    """Compile (or load from numba's cache) the motion kernel."""
-    occ = np.zeros((3, 3), dtype=np.bool_)
-    _bounce_trajectory(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.0, 0.0, 0.2, 0.5, 4, np.zeros(4))
-    _bounce_trajectory(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.0, 0.0, 0.2, 0.5, 4, np.zeros(0))
+    """Compile (or load from numba's cache) the motion kernel (writeable and read-only maps)."""
+    for ro in (False, True):
+        occ = np.zeros((3, 3), dtype=np.bool_)
+        occ.setflags(write=not ro)
+        _bounce_trajectory(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.0, 0.0, 0.2, 0.5, 4, np.zeros(4))
+        _bounce_trajectory(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.0, 0.0, 0.2, 0.5, 4, np.zeros(0))

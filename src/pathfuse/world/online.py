@@ -80,12 +80,12 @@ from pathfuse.field.forces import K_ATT, K_REP, RHO0_M, rep_force_xy
 from pathfuse.field.stepper import (
     AHEAD_PAPER_X,
     AHEAD_PROGRESS,
-    HOW_BLOCKED,
     MARGIN_FRAC,
     advance_progress,
     apf_force,
     fusion_force,
     safe_step,
+    segment_is_clear,
 )
 from pathfuse.grid import GridMap
 from pathfuse.result import ConfigError
@@ -114,6 +114,8 @@ __all__ = [
 
 GAP_MIN_M = 1e-3
 """Gaps below this (metres) are clamped in the moving-disc repulsion."""
+SIDE_SPEED = 0.05
+"""Sideways disc speed (m/s) above which the swerve passes behind the disc."""
 
 
 # ---------------------------------------------------------------------- context & base class
@@ -260,6 +262,14 @@ def _pos(name: str, v: Any, *, allow_zero: bool = False, optional: bool = False)
                           f"got {v!r}")
 
 
+def _floats(obj: Any, *names: str) -> None:
+    """Store numeric fields of a frozen dataclass as floats (one numba type per kernel)."""
+    for n in names:
+        v = getattr(obj, n)
+        if v is not None:
+            object.__setattr__(obj, n, float(v))
+
+
 def _choice(name: str, v: Any, choices: tuple[str, ...]) -> None:
     if v not in choices:
         raise ConfigError(f"{name}: must be one of {', '.join(choices)}, got {v!r}")
@@ -282,6 +292,7 @@ class _MovingRepulsion:
     repulsion: str = "position"
     a_max: float = 1.0
     swerve: float = 1.0
+    dodge: bool = True
 
     def _check_moving(self) -> None:
         _pos("k_rep_moving", self.k_rep_moving, allow_zero=True, optional=True)
@@ -289,6 +300,8 @@ class _MovingRepulsion:
         _choice("repulsion", self.repulsion, ("position", "velocity"))
         _pos("a_max", self.a_max)
         _pos("swerve", self.swerve, allow_zero=True)
+        _flag("dodge", self.dodge)
+        _floats(self, "k_rep_moving", "rho0_moving_m", "a_max", "swerve")
 
 
 @dataclass(frozen=True)
@@ -308,6 +321,11 @@ class APFOnlineParams(_MovingRepulsion):
         Braking deceleration of the velocity-aware form (m/s^2).
     swerve : float
         Tangential share of the moving-disc repulsion (0 = pure eq. 6).
+    dodge : bool
+        When the step along the force is blocked by the static map while
+        discs are sensed (a disc pressing the robot against a wall), take
+        instead the clear full step, among 12 directions, that most increases
+        the gap to the discs predicted one tick ahead (ours, not the paper's).
     """
 
     k_att: float = K_ATT
@@ -319,6 +337,7 @@ class APFOnlineParams(_MovingRepulsion):
         _pos("k_rep", self.k_rep, allow_zero=True)
         _pos("rho0_m", self.rho0_m)
         self._check_moving()
+        _floats(self, "k_att", "k_rep", "rho0_m")
 
 
 @dataclass(frozen=True)
@@ -338,11 +357,16 @@ class FusionOnlineParams(APFOnlineParams):
     heuristic : {"euclidean", "octile"}
         A* heuristic (paper: Euclidean, eq. 2).
     escape_ticks : int
-        When the robot has moved less than one step in total over this many
-        ticks, it follows the A* path alone (pure pursuit with the same safe
-        step) until it has passed ``escape_points`` path points; 0 disables.
+        Stall test of the local-minimum escape: when the robot's net move
+        over this many ticks is below 2.5 steps, it *escapes*: it walks back
+        along its own trajectory to the point from which the cheapest rejoin
+        of the A* path is in sight (:func:`rejoin_point`), goes straight to
+        that path point and follows the A* path until its progress is
+        ``escape_points`` points further, pulled by a point ``r1_m`` ahead on
+        that route (eq. 5) and still repelled by the moving discs; then
+        Algorithm 2 resumes.  0 disables (the paper as printed).
     escape_points : int
-        Path points to pass in escape mode.
+        Path points to follow in escape mode.
     """
 
     r1_m: float = 1.5
@@ -350,12 +374,13 @@ class FusionOnlineParams(APFOnlineParams):
     ahead: str = "progress"
     heuristic: str = "euclidean"
     escape_ticks: int = 20
-    escape_points: int = 5
+    escape_points: int = 3
 
     def __post_init__(self) -> None:
         super().__post_init__()
         _pos("r1_m", self.r1_m)
         _pos("r2_m", self.r2_m)
+        _floats(self, "r1_m", "r2_m")
         _choice("ahead", self.ahead, ("progress", "paper-x"))
         _choice("heuristic", self.heuristic, _HEURISTICS)
         for n in ("escape_ticks", "escape_points"):
@@ -402,6 +427,7 @@ class AStarReplanParams:
     def __post_init__(self) -> None:
         _pos("replan_period_s", self.replan_period_s)
         _pos("margin_m", self.margin_m, allow_zero=True)
+        _floats(self, "replan_period_s", "margin_m")
         _choice("heuristic", self.heuristic, _HEURISTICS)
 
 
@@ -585,11 +611,15 @@ def disc_repulsion(x: float, y: float, vx: float, vy: float, radius: float, pos:
                 mag = math.sqrt(rx * rx + ry * ry)
                 # obstacle left of the intended motion (cross > 0) -> push right, and
                 # a disc dead ahead (cross == 0) too
-                cross = ux_des * (-cy) - uy_des * (-cx)
+                # the side to pass on: behind a disc that moves across the intended
+                # motion; else away from the disc's side; a disc dead ahead: to the right
+                w = vel[i, 0] * (-uy_des) + vel[i, 1] * ux_des  # disc velocity to the left
+                cross = ux_des * (-cy) - uy_des * (-cx)  # > 0: disc left of the motion
+                go_left = w < -SIDE_SPEED if abs(w) > SIDE_SPEED else cross < 0.0
                 tx = -uy
                 ty = ux
                 left = tx * (-uy_des) + ty * ux_des  # component along the left normal
-                if (cross >= 0.0 and left > 0.0) or (cross < 0.0 and left < 0.0):
+                if (left > 0.0) != go_left:
                     tx = -tx
                     ty = -ty
                 rx += swerve * mag * ahead * tx
@@ -612,15 +642,21 @@ def warmup_online() -> None:
     for va in (False, True):
         disc_repulsion(0.0, 0.0, 0.5, 0.0, 0.2, p + 1.0, p, np.ones(1), 5.0, 2.0, 2.0, va, 1.0,
                        1.0, 1.0, 0.0)
-    occ = np.zeros((3, 4), dtype=np.bool_)
-    occ[1, 1] = True
     pts = np.array([[0.5, 0.5], [1.5, 0.5], [2.5, 1.5]])
     cum = _cumlen(pts)
-    advance_progress(0.5, 0.5, pts, cum, 0, 1.5)
-    fusion_force(0.5, 0.5, 3.5, 2.5, pts, cum, 0, AHEAD_PROGRESS, 40.0, 5.0, 2.0, 1.5, 2.0, occ,
-                 0.0, 0.0, 1.0)
-    apf_force(0.5, 0.5, 3.5, 2.5, 40.0, 5.0, 2.0, 2.0, occ, 0.0, 0.0, 1.0)
-    safe_step(0.5, 0.5, 1.0, 1.0, 0.1, occ, 0.0, 0.0, 1.0, 0.2)
+    for ro in (False, True):
+        occ = np.zeros((3, 4), dtype=np.bool_)
+        occ[1, 1] = True
+        occ.setflags(write=not ro)
+        advance_progress(0.5, 0.5, pts, cum, 0, 1.5, occ, 0.0, 0.0, 1.0, 0.2)
+        for ahead in (AHEAD_PROGRESS, AHEAD_PAPER_X):
+            fusion_force(0.5, 0.5, 3.5, 2.5, pts, cum, 0, ahead, 40.0, 5.0, 2.0, 1.5, 2.0, occ,
+                         0.0, 0.0, 1.0)
+        apf_force(0.5, 0.5, 3.5, 2.5, 40.0, 5.0, 2.0, 2.0, occ, 0.0, 0.0, 1.0)
+        safe_step(0.5, 0.5, 1.0, 1.0, 0.1, occ, 0.0, 0.0, 1.0, 0.2)
+        rejoin_point(pts, 3, pts, cum, 0, 1.5, occ, 0.0, 0.0, 1.0, 0.2)
+    occ = np.zeros((3, 4), dtype=np.bool_)
+    _rasterise_discs(occ, 0.0, 0.0, 1.0, pts, np.ones(3), 0.2)
 
 
 # ---------------------------------------------------------------------- APF-style planners
@@ -671,9 +707,39 @@ class _FieldPlanner(OnlinePlanner):
         nx, ny, how = safe_step(x, y, fx, fy, step, self._occ, self._ox, self._oy, self._res,
                                 self._clear_m)
         self.last_how = how
-        if how == HOW_BLOCKED:
-            return np.zeros(2)
+        if p.dodge and len(sens) and math.hypot(nx - x, ny - y) < 0.5 * step:
+            d = self._dodge(obs, x, y, fx, fy, step)
+            if d is not None:
+                nx, ny = d
         return np.array([(nx - x) / ctx.dt, (ny - y) / ctx.dt])
+
+    def _dodge(self, obs: Any, x: float, y: float, fx: float, fy: float,
+               step: float) -> tuple[float, float] | None:
+        """A full clear step that most increases the predicted gap to the sensed discs.
+
+        Used when the force's own step is blocked by the static map (typically a
+        disc pressing the robot against a wall).  The discs are predicted one
+        tick ahead at their current velocity.  None when no clear step beats
+        standing still.
+        """
+        sens = obs.obstacles
+        q = sens.positions + sens.velocities * self.ctx.dt
+
+        def gap(px: float, py: float) -> float:
+            return float((np.hypot(q[:, 0] - px, q[:, 1] - py) - sens.radii).min())
+
+        best = gap(x, y)
+        best_xy = None
+        a0 = math.atan2(fy, fx) if (fx or fy) else 0.0
+        for k in range(12):  # every 30 degrees, nearest to the force first
+            a = a0 + math.pi / 6 * ((k + 1) // 2) * (1 if k % 2 else -1)
+            tx, ty = x + step * math.cos(a), y + step * math.sin(a)
+            if segment_is_clear(x, y, tx, ty, self._occ, self._ox, self._oy, self._res,
+                                self._clear_m):
+                gp = gap(tx, ty)
+                if gp > best + 1e-9:
+                    best, best_xy = gp, (tx, ty)
+        return best_xy
 
     def act(self, obs: Any) -> np.ndarray:
         fx, fy = self.static_force(float(obs.position[0]), float(obs.position[1]))
@@ -691,8 +757,48 @@ class APFOnline(_FieldPlanner):
                          self._occ, self._ox, self._oy, self._res)
 
 
+@njit(cache=True)
+def rejoin_point(walk: np.ndarray, n: int, pts: np.ndarray, cum: np.ndarray, k: int,
+                 rvis_m: float, occ: np.ndarray, ox: float, oy: float, res: float,
+                 clear: float) -> tuple[int, int]:
+    """Where a stalled robot should rejoin its global path.
+
+    Over the walked points ``walk[:n]`` (the robot is at ``walk[n - 1]``) and
+    the path points ``pts[j]``, ``j >= k``, within ``rvis_m`` of them with a
+    clear straight move between the two (:func:`~pathfuse.field.stepper.segment_is_clear`),
+    returns the pair ``(i, j)`` minimising "walk back from ``walk[n - 1]`` to
+    ``walk[i]``, go straight to ``pts[j]``, follow the path to its end";
+    ``(-1, -1)`` when none is in sight.
+    """
+    m = pts.shape[0]
+    r2 = rvis_m * rvis_m
+    back = 0.0
+    best = np.inf
+    bi = -1
+    bj = -1
+    for i in range(n - 1, -1, -1):
+        x = walk[i, 0]
+        y = walk[i, 1]
+        if i < n - 1:
+            back += math.hypot(x - walk[i + 1, 0], y - walk[i + 1, 1])
+        if back >= best:
+            break
+        for j in range(k, m):
+            dx = pts[j, 0] - x
+            dy = pts[j, 1] - y
+            d2 = dx * dx + dy * dy
+            if d2 < r2:
+                cost = back + math.sqrt(d2) + cum[m - 1] - cum[j]
+                if cost < best and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy,
+                                                    res, clear):
+                    best = cost
+                    bi = i
+                    bj = j
+    return bi, bj
+
+
 class FusionOnline(_FieldPlanner):
-    """Algorithm 2 online, with an optional escape along the A* path (see the parameters)."""
+    """Algorithm 2 online, with a local-minimum escape along the A* path (see the parameters)."""
 
     name = "fusion"
 
@@ -708,37 +814,95 @@ class FusionOnline(_FieldPlanner):
         self._cum = _cumlen(self._pts)
         self._k = 0
         self._ahead = AHEAD_PAPER_X if p.ahead == "paper-x" else AHEAD_PROGRESS
-        self._escape_until = -1
-        self._hist: list[np.ndarray] = []
+        self._walk = np.empty((1024, 2))
+        self._n = 0
+        self._mark = 0  # walk index from which the stall test looks back
+        self._route: np.ndarray | None = None
+        self.escapes = 0
 
     def _reach(self) -> float:
         return self.params.r2_m
 
+    def _record(self, x: float, y: float) -> None:
+        if self._n == self._walk.shape[0]:
+            self._walk = np.concatenate([self._walk, np.empty_like(self._walk)])
+        self._walk[self._n, 0] = x
+        self._walk[self._n, 1] = y
+        self._n += 1
+
+    def _start_escape(self) -> None:
+        p = self.params
+        # any path point may be the rejoin point (the start always sees the first one);
+        # the cost, which includes the rest of the path, prefers those ahead
+        i, j = rejoin_point(self._walk, self._n, self._pts, self._cum, 0,
+                            p.r1_m + self._res, self._occ, self._ox, self._oy, self._res,
+                            self._clear_m)
+        if i < 0:
+            return
+        m = self._pts.shape[0]
+        end = min(max(j, self._k) + p.escape_points, m - 1)
+        route = np.concatenate([self._walk[i:self._n][::-1], self._pts[j:end + 1]])
+        keep = np.ones(len(route), dtype=bool)
+        keep[1:] = np.any(np.diff(route, axis=0) != 0.0, axis=1)
+        self._route = route[keep]
+        self._route_cum = _cumlen(self._route)
+        self._route_s = 0.0
+        self._route_end_k = end
+        self.escapes += 1
+
+    def _escape_force(self, x: float, y: float) -> tuple[float, float]:
+        """Pull towards a point up to ``r1`` ahead of the robot's projection on the escape route.
+
+        The look-ahead is halved (down to one step) until the point is in sight.
+        """
+        r, cum = self._route, self._route_cum
+        a, b = r[:-1], r[1:]
+        d = b - a
+        l2 = np.maximum((d * d).sum(axis=1), 1e-300)
+        t = np.clip(((x - a[:, 0]) * d[:, 0] + (y - a[:, 1]) * d[:, 1]) / l2, 0.0, 1.0)
+        near = np.hypot(a[:, 0] + t * d[:, 0] - x, a[:, 1] + t * d[:, 1] - y)
+        s_proj = cum[:-1] + t * np.sqrt(l2)
+        # only look a little ahead of the current progress on the route
+        window = (s_proj >= self._route_s - 1e-9) \
+            & (s_proj <= self._route_s + 2.0 * self.params.r1_m)
+        if window.any():
+            idx = np.flatnonzero(window)
+            self._route_s = float(s_proj[idx[np.argmin(near[idx])]])
+        look = self.params.r1_m
+        while True:  # the farthest carrot within r1 ahead that is in sight
+            target = _point_at(r, cum, self._route_s + look)
+            if look <= self._step or segment_is_clear(x, y, float(target[0]), float(target[1]),
+                                                      self._occ, self._ox, self._oy, self._res,
+                                                      self._clear_m):
+                break
+            look *= 0.5
+        k_att = self.params.k_att
+        return k_att * (float(target[0]) - x), k_att * (float(target[1]) - y)
+
     def act(self, obs: Any) -> np.ndarray:
         p = self.params
         x, y = float(obs.position[0]), float(obs.position[1])
-        self._k = advance_progress(x, y, self._pts, self._cum, self._k, p.r1_m)
-        m = self._pts.shape[0]
-        if self._escape_until >= 0 and self._k >= self._escape_until:
-            self._escape_until = -1
-            self._hist.clear()
-        if self._escape_until >= 0:
-            j = min(self._k + 1, m - 1)
-            fx = self._pts[j, 0] - x
-            fy = self._pts[j, 1] - y
+        self._record(x, y)
+        self._k = advance_progress(x, y, self._pts, self._cum, self._k, p.r1_m, self._occ,
+                                   self._ox, self._oy, self._res, self._clear_m)
+        if self._route is not None and self._k >= self._route_end_k:
+            self._route = None
+            self._mark = self._n - 1
+        if self._route is not None:
+            fx, fy = self._escape_force(x, y)
             return self.step_velocity(obs, fx, fy)
         fx, fy, _ = fusion_force(x, y, self._gx, self._gy, self._pts, self._cum, self._k,
                                  self._ahead, p.k_att, p.k_rep, p.rho0_m, p.r1_m, p.r2_m,
                                  self._occ, self._ox, self._oy, self._res)
-        v = self.step_velocity(obs, fx, fy)
-        if p.escape_ticks > 0:
-            self._hist.append(obs.position)
-            if len(self._hist) > p.escape_ticks:
-                old = self._hist.pop(0)
-                if math.hypot(x - old[0], y - old[1]) < self._step:
-                    self._escape_until = min(self._k + p.escape_points, m - 1)
-                    self._hist.clear()
-        return v
+        w = p.escape_ticks
+        if w > 0 and self._n - 1 - self._mark >= w:
+            old = self._walk[self._n - 1 - w]
+            if math.hypot(x - old[0], y - old[1]) < 2.5 * self._step:
+                self._start_escape()
+                self._mark = self._n - 1
+                if self._route is not None:
+                    fx, fy = self._escape_force(x, y)
+        return self.step_velocity(obs, fx, fy)
 
 
 # ---------------------------------------------------------------------- A* followers

@@ -255,12 +255,12 @@ def _budget(limits: Mapping[str, Any]) -> Any:
 
 def _reference(group: Mapping[str, Any], run: Mapping[str, Any], pgrid: Any,
                start: np.ndarray, goal: np.ndarray) -> tuple[float | None, str | None]:
+    q = run["query"]
+    if "optimal_length" in q and run["robot_radius_m"] <= 0:
+        return float(q["optimal_length"]), "scen"  # the benchmark's own optimum
     ref = run.get("reference")
     if ref is None:
         return None, None
-    q = run["query"]
-    if "optimal_length" in q and run["robot_radius_m"] <= 0:
-        return float(q["optimal_length"]), "scen"
     key = (group["map_key"], float(run["robot_radius_m"]), ref["planner"],
            json.dumps(ref.get("params") or {}, sort_keys=True),
            tuple(np.round(start, 9)), tuple(np.round(goal, 9)))
@@ -346,7 +346,8 @@ def _metric_columns(m: Mapping[str, Any] | None) -> dict[str, Any]:
         "collision_free": None if cf is None else bool(cf),
         "collisions": None if coll is None else int(coll),
         "steps": None if steps is None else int(steps),
-        "metrics": json.dumps(_scalars(m), sort_keys=True),
+        "metrics": json.dumps({k: v for k, v in _scalars(m).items() if not _is_timing(k)},
+                              sort_keys=True),
     }
 
 

@@ -18,6 +18,7 @@ File layout
     limits: {time_limit_s: 5, max_iterations: 200000}   # per run (pathfuse.Budget)
     robot_radius_m: 0.0              # plan on the map inflated by this radius
     reference: astar                 # planner whose length defines R_length; null: none
+                                     # (scen queries use the file's optimum instead)
     store_paths: false               # keep every path (float64 (N, 2)) in runs.path
     imports: [my_planners.py]        # modules / .py files that register extra planners
     maps:

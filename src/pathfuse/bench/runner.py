@@ -270,7 +270,8 @@ def _mp_context() -> Any:
     methods = mp.get_all_start_methods()
     if "forkserver" in methods:
         ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["pathfuse", "pathfuse.bench.execute"])
+        ctx.set_forkserver_preload(["pathfuse", "pathfuse.bench.execute",
+                                    "pathfuse.bench._preload"])
         return ctx
     return mp.get_context("spawn")
 

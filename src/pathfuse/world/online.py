@@ -629,8 +629,14 @@ def disc_repulsion(x: float, y: float, vx: float, vy: float, radius: float, pos:
     return fx, fy
 
 
+_WARM = False
+
+
 def warmup_online() -> None:
-    """Compile (or load from numba's cache) every kernel the online planners use."""
+    """Compile (or load from numba's cache) every kernel the online planners use (once)."""
+    global _WARM
+    if _WARM:
+        return
     from pathfuse.search.astar import warmup as astar_warmup
     from pathfuse.world.geometry import warmup_geometry
     from pathfuse.world.obstacles import warmup_obstacles
@@ -657,6 +663,7 @@ def warmup_online() -> None:
         rejoin_point(pts, 3, pts, cum, 0, 1.5, occ, 0.0, 0.0, 1.0, 0.2)
     occ = np.zeros((3, 4), dtype=np.bool_)
     _rasterise_discs(occ, 0.0, 0.0, 1.0, pts, np.ones(3), 0.2)
+    _WARM = True
 
 
 # ---------------------------------------------------------------------- APF-style planners

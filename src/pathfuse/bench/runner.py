@@ -362,10 +362,27 @@ def _connect_dask(scheduler: Any) -> tuple[Any, bool]:
     if not isinstance(scheduler, str) or "://" not in scheduler:
         raise ConfigError(f"scheduler: expected an address like tcp://HOST:8786, "
                           f"got {scheduler!r}")
+    _probe(scheduler)
     try:
-        return distributed.Client(scheduler, timeout="15s", set_as_default=False), True
+        return distributed.Client(scheduler, timeout="20s", set_as_default=False), True
     except (OSError, TimeoutError) as exc:
         raise ConfigError(f"scheduler: cannot connect to {scheduler} ({exc})") from None
+
+
+def _probe(address: str, timeout_s: float = 5.0) -> None:
+    """Fail fast when nothing listens at a ``tcp://HOST:PORT`` address."""
+    import socket
+    from urllib.parse import urlsplit
+
+    u = urlsplit(address)
+    if u.scheme != "tcp" or u.port is None:
+        return
+    try:
+        with socket.create_connection((u.hostname or "127.0.0.1", u.port), timeout=timeout_s):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"scheduler: cannot connect to {address} ({exc.strerror or exc}); "
+                          "is 'dask scheduler' running there?") from None
 
 
 def _run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: _Sink, scheduler: Any,
@@ -395,7 +412,7 @@ def _run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: _Sink, scheduler: 
             index[f] = b
             futures.append(f)
         singles: list[RunSpec] = []
-        for f in as_completed(futures):
+        for f in as_completed(futures, loop=client.loop):
             b = index.pop(f)
             try:
                 sink.write(f.result())
@@ -413,7 +430,7 @@ def _run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: _Sink, scheduler: 
                 index[f] = r
                 fs.append(f)
             futures.extend(fs)
-            for f in as_completed(fs):
+            for f in as_completed(fs, loop=client.loop):
                 r = index.pop(f)
                 try:
                     sink.write(f.result())

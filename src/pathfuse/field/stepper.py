@@ -606,7 +606,7 @@ def fusion_run(buf, n, n_stop, max_steps, occ, pts, cum, state, fcfg, icfg):
                 else:
                     t += 1
                 continue
-            if d <= step:
+            if d <= step * (1.0 + 1e-9):  # land exactly (no sliver step left by rounding)
                 nx = tx
                 ny = ty
             else:

@@ -500,9 +500,9 @@ def global_astar_path(grid: GridMap, start: np.ndarray, goal: np.ndarray, radius
     returns ``[start, cell centres..., goal]`` with the first and last cell
     centres dropped when the straight move past them is clear.
 
-    >>> g = GridMap.from_rows(["....", ".##.", "...."])
+    >>> g = GridMap.from_rows(["....", ".##.", ".#.."])
     >>> global_astar_path(g, np.array([0.5, 0.5]), np.array([3.5, 2.5]), 0.2).tolist()
-    [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
+    [[0.5, 0.5], [0.5, 1.5], [0.5, 2.5], [1.5, 2.5], [2.5, 2.5], [3.5, 2.5]]
     """
     start = np.asarray(start, dtype=np.float64)
     goal = np.asarray(goal, dtype=np.float64)

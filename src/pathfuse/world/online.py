@@ -284,28 +284,7 @@ _HEURISTICS = ("euclidean", "octile")
 
 
 @dataclass(frozen=True)
-class _MovingRepulsion:
-    """Parameters of the moving-disc repulsion shared by the APF-style planners."""
-
-    k_rep_moving: float | None = None
-    rho0_moving_m: float | None = None
-    repulsion: str = "position"
-    a_max: float = 1.0
-    swerve: float = 1.0
-    dodge: bool = True
-
-    def _check_moving(self) -> None:
-        _pos("k_rep_moving", self.k_rep_moving, allow_zero=True, optional=True)
-        _pos("rho0_moving_m", self.rho0_moving_m, optional=True)
-        _choice("repulsion", self.repulsion, ("position", "velocity"))
-        _pos("a_max", self.a_max)
-        _pos("swerve", self.swerve, allow_zero=True)
-        _flag("dodge", self.dodge)
-        _floats(self, "k_rep_moving", "rho0_moving_m", "a_max", "swerve")
-
-
-@dataclass(frozen=True)
-class APFOnlineParams(_MovingRepulsion):
+class APFOnlineParams:
     """Online plain APF.
 
     Attributes
@@ -331,13 +310,25 @@ class APFOnlineParams(_MovingRepulsion):
     k_att: float = K_ATT
     k_rep: float = K_REP
     rho0_m: float = RHO0_M
+    k_rep_moving: float | None = None
+    rho0_moving_m: float | None = None
+    repulsion: str = "position"
+    a_max: float = 1.0
+    swerve: float = 1.0
+    dodge: bool = True
 
     def __post_init__(self) -> None:
         _pos("k_att", self.k_att)
         _pos("k_rep", self.k_rep, allow_zero=True)
         _pos("rho0_m", self.rho0_m)
-        self._check_moving()
-        _floats(self, "k_att", "k_rep", "rho0_m")
+        _pos("k_rep_moving", self.k_rep_moving, allow_zero=True, optional=True)
+        _pos("rho0_moving_m", self.rho0_moving_m, optional=True)
+        _choice("repulsion", self.repulsion, ("position", "velocity"))
+        _pos("a_max", self.a_max)
+        _pos("swerve", self.swerve, allow_zero=True)
+        _flag("dodge", self.dodge)
+        _floats(self, "k_att", "k_rep", "rho0_m", "k_rep_moving", "rho0_moving_m", "a_max",
+                "swerve")
 
 
 @dataclass(frozen=True)
@@ -374,7 +365,7 @@ class FusionOnlineParams(APFOnlineParams):
     ahead: str = "progress"
     heuristic: str = "euclidean"
     escape_ticks: int = 20
-    escape_points: int = 3
+    escape_points: int = 6
 
     def __post_init__(self) -> None:
         super().__post_init__()

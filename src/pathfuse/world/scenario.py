@@ -450,11 +450,12 @@ def _parse_planner(v: Any) -> PlannerChoice:
         raise ScenarioError(f"planner.params: must be a mapping, got {params!r}")
     try:
         spec = get_online_planner(name)
-        make_online_params(spec, params, key="planner.params")
-    except ScenarioError:
-        raise
     except ConfigError as exc:
         raise ScenarioError(f"planner.name: {exc}") from None
+    try:
+        make_online_params(spec, params, key="planner.params")
+    except ConfigError as exc:
+        raise ScenarioError(str(exc)) from None
     return PlannerChoice(name=spec.name, params=dict(params))
 
 

@@ -16,11 +16,11 @@ swerve and dodge).  A sub-goal is passed when the robot comes within
     ``(rho_g / L)^n`` with ``rho_g`` the distance to the current sub-goal (or
     the goal), so sub-goals next to obstacles are reachable.
 ``ref7``
-    Sub-goals: the ends of sub-segments of the A* path, every
-    ``segment_points`` path points, then the goal; plain APF (eq. 5/6,
+    Sub-goals: the ends of sub-segments of the A* path
+    (:func:`pathfuse.planners.ref7.segment_ends`: the first A* point at least
+    ``segment_length_m`` along the path after the previous end, or every
+    ``segment_points``-th point), the goal last; plain APF (eq. 5/6,
     :func:`pathfuse.field.stepper.apf_force`) from segment end to segment end.
-    The offline planner (:mod:`pathfuse.planners.ref7`) was not available
-    when this was written; this follows the paper's one-sentence description.
 
 Examples
 --------
@@ -41,6 +41,7 @@ import numpy as np
 
 from pathfuse.field.stepper import apf_force, grid_repulsion
 from pathfuse.planners.ref6 import Ref6Params, grid_improved_repulsion, inflection_points
+from pathfuse.planners.ref7 import Ref7Params, segment_ends
 from pathfuse.result import ConfigError
 from pathfuse.world.online import (
     APFOnlineParams,
@@ -57,6 +58,7 @@ from pathfuse.world.online import (
 __all__ = ["Ref6OnlineParams", "Ref7OnlineParams", "Ref6Online", "Ref7Online"]
 
 _R6 = Ref6Params()
+_R7 = Ref7Params()
 
 
 @dataclass(frozen=True)
@@ -103,26 +105,32 @@ class Ref7OnlineParams(APFOnlineParams):
     ----------
     k_att, k_rep, rho0_m, k_rep_moving, rho0_moving_m, repulsion, a_max, swerve, dodge
         As in :class:`~pathfuse.world.online.APFOnlineParams`.
-    segment_points : int
-        A* path points per sub-segment (>= 1).
+    segment_length_m : float
+        Path length of a sub-segment (a segment ends at the first A* point at
+        least this far along the path from the previous end).
+    segment_points : int or None
+        When given, every ``segment_points``-th A* point ends a segment instead.
     subgoal_tolerance_m : float or None
         Distance at which a segment end counts as passed (default: half a cell).
     heuristic : {"euclidean", "octile"}
         A* heuristic.
     """
 
-    segment_points: int = 3
-    subgoal_tolerance_m: float | None = None
+    segment_length_m: float = _R7.segment_length_m
+    segment_points: int | None = _R7.segment_points
+    subgoal_tolerance_m: float | None = _R7.segment_tolerance_m
     heuristic: str = "euclidean"
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        _pos("segment_length_m", self.segment_length_m)
         v = self.segment_points
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-            raise ConfigError(f"segment_points: must be an integer >= 1, got {v!r}")
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, np.integer))
+                              or v < 1):
+            raise ConfigError(f"segment_points: must be an integer >= 1 or null, got {v!r}")
         _pos("subgoal_tolerance_m", self.subgoal_tolerance_m, optional=True)
         _choice("heuristic", self.heuristic, ("euclidean", "octile"))
-        _floats(self, "subgoal_tolerance_m")
+        _floats(self, "segment_length_m", "subgoal_tolerance_m")
 
 
 class _SubgoalPlanner(_FieldPlanner):
@@ -196,8 +204,8 @@ class Ref7Online(_SubgoalPlanner):
     name = "ref7"
 
     def subgoals(self, path: np.ndarray) -> np.ndarray:
-        k = int(self.params.segment_points)
-        return path[k::k]
+        p = self.params
+        return path[segment_ends(path, p.segment_length_m, p.segment_points)]
 
     def subgoal_force(self, x: float, y: float, sx: float, sy: float) -> tuple[float, float]:
         p = self.params

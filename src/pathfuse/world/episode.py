@@ -90,8 +90,8 @@ class Episode:
     global_path : (N, 2) float array or None
         The planner's first global path (A* through cell centres), if any.
     path_updates : list of (tick, (N, 2) array)
-        Every global path the planner adopted and the tick it did so
-        (more than one for replanning planners).
+        Every global path the planner adopted and the tick of the observation
+        it planned from (more than one for replanning planners).
     path_length_m : float
         Length of the robot's trajectory.
     time_to_goal_s : float or None
@@ -247,6 +247,7 @@ def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = N
         status, message = _failure_status(planner)
     else:
         while True:
+            acted = obs.tick
             t0 = time.perf_counter()
             action = planner.act(obs)
             plan_times[n - 1] = time.perf_counter() - t0
@@ -259,7 +260,7 @@ def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = N
             n += 1
             gp = planner.global_path
             if gp is not None and gp is not last_path:
-                path_updates.append((n - 1, np.array(gp)))
+                path_updates.append((acted, np.array(gp)))
                 last_path = gp
             if terminated:
                 if info["event"] == "reached":

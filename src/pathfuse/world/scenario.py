@@ -279,6 +279,15 @@ def _check_point(grid: GridMap, p: tuple[float, float], r: float, key: str, what
 def _check_scene(sc: Scenario) -> None:
     if not isinstance(sc.grid, GridMap):
         raise ScenarioError(f"map: must be a GridMap, got {type(sc.grid).__name__}")
+    # numbers (the parser checks them too; this guards Scenario(...) and replace())
+    _num(sc.dt, "dt", gt=0)
+    _num(sc.time_limit, "time_limit", gt=0)
+    _num(sc.goal_tolerance, "goal_tolerance", gt=0)
+    _num(sc.stall_time, "stall_time", ge=0)
+    _num(sc.stall_radius, "stall_radius", gt=0)
+    _num(sc.robot.radius, "robot.radius", ge=0)
+    _num(sc.robot.max_speed, "robot.max_speed", gt=0)
+    _num(sc.robot.sensing_radius, "robot.sensing_radius", gt=0)
     r = sc.robot.radius
     _check_point(sc.grid, sc.start, r, "start", "the robot")
     _check_point(sc.grid, sc.goal, r, "goal", "the robot")

@@ -108,25 +108,9 @@ from pathfuse.field.stepper import (
     CODE_BLOCKED,
     CODE_RUNNING,
     CODE_STALLED,
-    F_CLEAR,
-    F_GX,
-    F_GY,
-    F_KATT,
-    F_KREP,
-    F_OX,
-    F_OY,
-    F_RES,
-    F_RHO0,
-    F_STALLD,
-    F_STEP,
-    F_TOL,
     HOW_BLOCKED,
-    I_STALLN,
-    N_F,
-    N_I,
     _goal_reached,
     grid_repulsion,
-    pack_apf,
     safe_step,
 )
 from pathfuse.grid import GridMap
@@ -146,9 +130,12 @@ __all__ = [
 
 _TARGETS = {"subgoal": 0, "goal": 1}
 
-# extra config slots after pack_apf's
-F_SUBTOL, F_NEXP, F_SCALE = N_F, N_F + 1, N_F + 2
-I_TARGET = N_I
+# Slots of the float config of ref6_run.  Own layout, not stepper's: numba bakes
+# global constants into the cached machine code of *this* module, and its cache
+# is not invalidated when another module's constants change.
+(C_GX, C_GY, C_KATT, C_KREP, C_RHO0, C_STEP, C_TOL, C_CLEAR, C_STALLD, C_OX, C_OY, C_RES,
+ C_SUBTOL, C_NEXP, C_SCALE) = range(15)
+N_C = 15
 # state: current sub-goal index
 S_SUB = 0
 
@@ -344,29 +331,29 @@ def grid_improved_repulsion(x, y, tx, ty, occ, ox, oy, res, k_rep, rho0_m, n, sc
 
 
 @njit(cache=True)
-def ref6_run(buf, n, n_stop, max_steps, occ, subs, state, fcfg, icfg):
+def ref6_run(buf, n, n_stop, max_steps, occ, subs, state, cfg, stall_n, to_goal):
     """Improved-APF steps through the sub-goals ``subs`` (K, 2) (the last is the goal).
 
     The calling convention of :func:`pathfuse.field.stepper.apf_run`;
-    ``state[S_SUB]`` (the current sub-goal index) is carried between calls.
+    ``state[S_SUB]`` (the current sub-goal index) is carried between calls,
+    ``cfg`` is built by :func:`pack_ref6`, ``stall_n`` is the stall look-back in
+    steps and ``to_goal`` selects the final goal as the repulsion's target.
     """
-    gx = fcfg[F_GX]
-    gy = fcfg[F_GY]
-    k_att = fcfg[F_KATT]
-    k_rep = fcfg[F_KREP]
-    rho0 = fcfg[F_RHO0]
-    step = fcfg[F_STEP]
-    tol = fcfg[F_TOL]
-    clear = fcfg[F_CLEAR]
-    stall_d = fcfg[F_STALLD]
-    ox = fcfg[F_OX]
-    oy = fcfg[F_OY]
-    res = fcfg[F_RES]
-    sub_tol = fcfg[F_SUBTOL]
-    nexp = fcfg[F_NEXP]
-    scale = fcfg[F_SCALE]
-    stall_n = icfg[I_STALLN]
-    to_goal = icfg[I_TARGET] == 1
+    gx = cfg[C_GX]
+    gy = cfg[C_GY]
+    k_att = cfg[C_KATT]
+    k_rep = cfg[C_KREP]
+    rho0 = cfg[C_RHO0]
+    step = cfg[C_STEP]
+    tol = cfg[C_TOL]
+    clear = cfg[C_CLEAR]
+    stall_d = cfg[C_STALLD]
+    ox = cfg[C_OX]
+    oy = cfg[C_OY]
+    res = cfg[C_RES]
+    sub_tol = cfg[C_SUBTOL]
+    nexp = cfg[C_NEXP]
+    scale = cfg[C_SCALE]
     last = subs.shape[0] - 1
     j = state[S_SUB]
     x = buf[n - 1, 0]
@@ -412,6 +399,18 @@ def ref6_run(buf, n, n_stop, max_steps, occ, subs, state, fcfg, icfg):
     return n, code, steps
 
 
+def pack_ref6(goal, k_att, k_rep, rho0_m, step_m, tol_m, clear_m, stall_distance_m, ox, oy,
+              res, subgoal_tol_m, rep_exponent, rep_scale_m):
+    """The float config array of :func:`ref6_run`."""
+    c = np.zeros(N_C)
+    c[C_GX], c[C_GY] = float(goal[0]), float(goal[1])
+    c[C_KATT], c[C_KREP], c[C_RHO0] = k_att, k_rep, rho0_m
+    c[C_STEP], c[C_TOL], c[C_CLEAR], c[C_STALLD] = step_m, tol_m, clear_m, stall_distance_m
+    c[C_OX], c[C_OY], c[C_RES] = ox, oy, res
+    c[C_SUBTOL], c[C_NEXP], c[C_SCALE] = subgoal_tol_m, rep_exponent, rep_scale_m
+    return c
+
+
 # --------------------------------------------------------------------- planner
 def follow_subgoals(
     grid: GridMap,
@@ -449,15 +448,15 @@ def follow_subgoals(
     scale = float(p.rep_scale_m) if p.rep_scale_m is not None else float(p.rho0_m)
     deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
     ox, oy = grid.origin
-    f0, i0 = pack_apf(goal, p.k_att, p.k_rep, p.rho0_m, p.rho0_m, st.step_m,
-                      st.goal_tolerance_m, st.clear_m, p.stall_steps, st.stall_distance_m,
-                      ox, oy, grid.resolution)
-    fcfg = np.concatenate([f0, [sub_tol, float(p.rep_exponent), scale]])
-    icfg = np.concatenate([i0, np.array([_TARGETS[p.rep_target]], dtype=np.int64)])
+    cfg = pack_ref6(goal, p.k_att, p.k_rep, p.rho0_m, st.step_m, st.goal_tolerance_m,
+                    st.clear_m, st.stall_distance_m, ox, oy, grid.resolution, sub_tol,
+                    float(p.rep_exponent), scale)
+    stall_n = int(p.stall_steps)
+    to_goal = p.rep_target == "goal"
     state = np.zeros(1, dtype=np.int64)
     occ = grid.occupied
-    out = drive(lambda buf, n, n_stop, k: ref6_run(buf, n, n_stop, k, occ, subs, state, fcfg,
-                                                   icfg),
+    out = drive(lambda buf, n, n_stop, k: ref6_run(buf, n, n_stop, k, occ, subs, state, cfg,
+                                                   stall_n, to_goal),
                 start, st.max_steps, deadline)
     reached = int(state[S_SUB]) + (1 if out.status is Status.SUCCESS else 0)
     info = {

@@ -32,6 +32,7 @@ def _fmt(s: str) -> str:
 
 MAIN_EPILOG = _fmt("""
 examples:
+  pathfuse paper --seeds 100 --out paper-out
   pathfuse plan --map paper --seed 3 --plot plan.png
   pathfuse plan --map den312d.map --start 10.5,70.5 --goal 60.5,8.5 --json
   pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 500
@@ -200,6 +201,42 @@ def cmd_planners(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_paper(args: argparse.Namespace) -> int:
+    from pathfuse.bench.progress import ProgressBar
+    from pathfuse.paper import PaperConfig, run_paper, summary_rows, write_paper_outputs
+
+    cfg = PaperConfig(
+        n_seeds=args.seeds, first_seed=args.first_seed,
+        figure_seed=args.seed if args.seed is not None else args.first_seed,
+    )
+    if not cfg.first_seed <= cfg.figure_seed < cfg.first_seed + cfg.n_seeds:
+        raise CliError(
+            f"--seed {cfg.figure_seed} is not among the maps run "
+            f"({cfg.first_seed}..{cfg.first_seed + cfg.n_seeds - 1})"
+        )
+    bar = ProgressBar(cfg.n_seeds, label="paper maps", enabled=not args.quiet)
+    done = [0]
+
+    def progress(i: int, n: int) -> None:
+        bar.update(i - done[0])
+        done[0] = i
+
+    run = run_paper(cfg, progress=progress)
+    bar.close()
+    files = write_paper_outputs(run, args.out)
+    n_runs = len(run.records)
+    print(f"{n_runs} runs on {cfg.n_seeds} maps in {run.wall_s:.2f} s "
+          f"({n_runs / max(run.wall_s, 1e-9):.0f} runs/s, {cfg.n_seeds / max(run.wall_s, 1e-9):.1f} maps/s)")
+    print(f"{'planner':<8} {'success':>12} {'length mean':>12} {'R_length':>10} {'time mean':>11}")
+    for r in summary_rows(run):
+        rl = "-" if r["planner"] == "fusion" else f"{100 * r['r_length_mean']:+.2f}%"
+        print(f"{r['planner']:<8} {r['successes']:>5}/{r['maps']:<6} "
+              f"{r['length_mean_m']:>11.4f}m {rl:>10} {1e3 * r['time_mean_s']:>9.3f}ms")
+    for key, path in files.items():
+        print(f"wrote {path}")
+    return 0
+
+
 # --------------------------------------------------------------------------- parser
 def build_parser() -> argparse.ArgumentParser:
     from pathfuse import __version__
@@ -266,6 +303,29 @@ example:
                    help="A* heuristic (default octile; both are exact)")
     s.add_argument("--tol", type=_float, default=1e-6, help="relative tolerance (default 1e-6)")
     s.set_defaults(func=cmd_scen)
+
+    pp = sub.add_parser(
+        "paper",
+        help="reproduce the paper's Tables I and II and Fig. 3 over many seeded maps",
+        description="Run the paper's setup (15 m map, start (1, 1), goal (11, 11), 50 random "
+        "obstacles, K_att 40, K_rep 5, rho_0 2 m) with all five planners on N seeded maps and "
+        "write Tables I and II (one map and statistics over all maps) as Markdown and CSV, "
+        "Fig. 3 and a box plot of R_length into --out.",
+        epilog=_fmt("""
+examples:
+  pathfuse paper --out paper-out
+  pathfuse paper --seeds 1000 --seed 7 --out paper-1000
+"""),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    pp.add_argument("--seeds", type=_positive_int, default=100,
+                    help="number of maps (default 100)")
+    pp.add_argument("--first-seed", type=int, default=0, help="seed of the first map (default 0)")
+    pp.add_argument("--seed", type=int, default=None,
+                    help="the map of the one-map tables and Fig. 3 (default: the first seed)")
+    pp.add_argument("--out", default="paper-out", help="output folder (default paper-out)")
+    pp.add_argument("--quiet", action="store_true", help="no progress bar")
+    pp.set_defaults(func=cmd_paper)
 
     q = sub.add_parser(
         "planners", help="list the registered planners and their default parameters",

@@ -1,0 +1,74 @@
+"""Figures of the paper reproduction: Fig. 3 and the R_length box plot."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from pathfuse.viz.figures import PLANNER_COLOURS, draw_map, plt
+
+if TYPE_CHECKING:
+    from pathfuse.paper import PaperRun
+
+__all__ = ["plot_fig3", "plot_r_length"]
+
+_FIG3_ORDER = (("apf", "(a)"), ("astar", "(b)"), ("ref6", "(c)"), ("ref7", "(d)"))
+
+
+def plot_fig3(run: PaperRun, out: str | Path, dpi: int = 120) -> None:
+    """The paper's Fig. 3: the fusion path against each reference on one map."""
+    from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
+    from pathfuse.paper import PAPER_LABELS
+
+    seed = run.config.figure_seed
+    grid = paper_map(seed)
+    fusion = run.results.get((seed, "fusion"))
+    refs = [(k, tag) for k, tag in _FIG3_ORDER if (seed, k) in run.results]
+    ncol = 2
+    nrow = max(1, (len(refs) + 1) // 2)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(10, 5 * nrow), squeeze=False)
+    for ax in axes.ravel()[len(refs):]:
+        ax.axis("off")
+    for ax, (name, tag) in zip(axes.ravel(), refs):
+        draw_map(ax, grid)
+        if fusion is not None and "astar_path" in fusion.info:
+            a = np.asarray(fusion.info["astar_path"])
+            ax.plot(a[:, 0], a[:, 1], "o", ms=3, color="#1f77b4", alpha=0.6, label="A* points")
+        for res in (run.results[(seed, name)], fusion):
+            if res is None or len(res.path) == 0:
+                continue
+            p = np.asarray(res.path)
+            st = "" if res.success else f", {res.status.name}"
+            ax.plot(p[:, 0], p[:, 1], "-", lw=2, color=PLANNER_COLOURS.get(res.planner),
+                    label=f"{PAPER_LABELS.get(res.planner, res.planner)}: {res.length:.3f} m{st}")
+        ax.plot(*PAPER_START, "o", color="#2ca02c", ms=9, mec="k", zorder=5, label="start")
+        ax.plot(*PAPER_GOAL, "*", color="#ffbf00", ms=14, mec="k", zorder=5, label="goal")
+        ax.set_title(f"{tag} compared with {PAPER_LABELS.get(name, name)}", fontsize=10)
+        ax.legend(loc="upper left", fontsize=7, framealpha=0.9)
+    fig.suptitle(f"Fusion path against the references, paper-setup map seed {seed}")
+    fig.tight_layout()
+    fig.savefig(out, dpi=dpi)
+    plt.close(fig)
+
+
+def plot_r_length(run: PaperRun, r_by_ref: dict[str, np.ndarray], out: str | Path,
+                  dpi: int = 120) -> None:
+    """Box plot of R_length = (L_fusion - L_ref) / L_ref per reference, in percent."""
+    from pathfuse.paper import PAPER_LABELS
+
+    names = [k for k in r_by_ref if r_by_ref[k].size]
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    if names:
+        ax.boxplot([100 * r_by_ref[k] for k in names], showmeans=True)
+        ax.set_xticks(range(1, len(names) + 1))
+        ax.set_xticklabels(
+            [f"{PAPER_LABELS.get(k, k)}\n(n={r_by_ref[k].size})" for k in names], fontsize=8)
+    ax.axhline(0.0, color="k", lw=0.8, ls="--")
+    ax.set_ylabel("R_length = (L_fusion - L_ref) / L_ref  [%]")
+    ax.set_title(f"Fusion path length relative to each reference over "
+                 f"{run.config.n_seeds} maps (below 0: fusion shorter)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out, dpi=dpi)
+    plt.close(fig)

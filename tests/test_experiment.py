@@ -191,7 +191,9 @@ planners: [xsweep]
 def test_random_queries_and_dynamic_entries(tmp_path):
     online = pytest.importorskip("pathfuse.world.online")
     online.register_online(online.OnlinePlannerSpec("xonline", lambda p: None, _Params, "test"))
-    (tmp_path / "sc.yaml").write_text("anything: 1\n")
+    (tmp_path / "sc.yaml").write_text('map: {rows: ["......"]}\nstart: [0.5, 0.5]\n'
+                                      'goal: [5.5, 0.5]\nrobot: {radius: 0.2}\n')
+    (tmp_path / "bad.yaml").write_text("anything: 1\n")
     text = """
 seeds: 2
 maps:
@@ -208,6 +210,13 @@ planners: %s
     with pytest.raises(ConfigError, match=r"planners\[1\].name: unknown planner 'nope' "
                                           r"\(choose from static: .*; dynamic: "):
         load_experiment(write(tmp_path, text % "[xsweep, nope]"))
+    with pytest.raises(ConfigError, match=r"maps\[1\].dynamic: .*bad.yaml: anything: unknown"):
+        load_experiment(write(tmp_path, text.replace("sc.yaml", "bad.yaml")
+                              % "[xsweep, xonline]"))
+    gen = "  - name: gen\n    dynamic: {generate: {moving: 2, bogus: 1}}\n"
+    with pytest.raises(ConfigError, match=r"maps\[2\].dynamic.generate.bogus: unknown argument"):
+        load_experiment(write(tmp_path, text.replace("planners:", gen + "planners:")
+                              % "[xsweep, xonline]"))
     exp = load_experiment(write(tmp_path, text % "[xsweep, xonline]"))
     assert [p.kinds for p in exp.planners] == [("static",), ("dynamic",)]
     runs = exp.expand()

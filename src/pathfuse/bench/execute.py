@@ -133,12 +133,12 @@ def execute_run(group: Mapping[str, Any], run: Mapping[str, Any],
 
 
 def _worker_name() -> str:
-    try:
-        from distributed import get_worker  # type: ignore[import-not-found]
-
-        return str(get_worker().address)
-    except Exception:  # noqa: BLE001 - not on a dask worker (or no dask)
-        return f"pid {os.getpid()}"
+    if "distributed" in sys.modules:  # never import dask just to ask
+        try:
+            return str(sys.modules["distributed"].get_worker().address)
+        except Exception:  # noqa: BLE001 - not on a dask worker
+            pass
+    return f"pid {os.getpid()}"
 
 
 def _error_row(exc: BaseException) -> dict[str, Any]:
@@ -396,12 +396,12 @@ def run_static(group: Mapping[str, Any], run: Mapping[str, Any],
 # --------------------------------------------------------------------------- dynamic runs
 def _scenario(group: Mapping[str, Any]) -> Any:
     """The group's dynamic scenario, loaded once per process."""
-    from pathfuse.world import load_scenario
+    from pathfuse.bench.experiment import load_dynamic
 
     key = (group["map_key"], "scenario")
     with _LOCK:
         if key not in _MAPS:
-            _lru_put(_MAPS, key, load_scenario(group["map_spec"]["dynamic"]), _MAP_CACHE_SIZE)
+            _lru_put(_MAPS, key, load_dynamic(group["map_spec"]), _MAP_CACHE_SIZE)
         return _MAPS[key]
 
 

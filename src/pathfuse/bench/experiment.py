@@ -37,6 +37,8 @@ File layout
         queries: [{start: [-1.0, -0.5], goal: [1.5, 0.5]}]
       - name: crossing
         dynamic: scenarios/crossing.yaml      # dynamic world (pathfuse.world.simulate)
+      - name: paper-dynamic                   # a generated family: one scenario per seed
+        dynamic: {generate: {moving: 3, speed_range: [0.2, 0.8]}}
     planners:
       - astar
       - name: fusion
@@ -518,12 +520,15 @@ class Experiment:
             dyn = entry.dynamic
             if isinstance(dyn, str):
                 p = self.resolve(dyn)
-                portable = {"dynamic": dyn, "sha256": file_digest(p)}
-                load = {"dynamic": str(p.resolve())}
+                portable: dict[str, Any] = {"dynamic": dyn, "sha256": file_digest(p)}
+                load: dict[str, Any] = {"dynamic": str(p.resolve())}
+            elif "generate" in dyn:  # a generated family: one scenario per seed
+                portable = {"dynamic": {"generate": dyn["generate"], "seed": int(seed)}}
+                load = portable
             else:
                 portable = {"dynamic": dyn}
-                load = {"dynamic": dyn}
-            return portable, load, run_key({"seed": seed, **portable})[:24]
+                load = {"dynamic": dyn, "base_dir": str(self.base_dir.resolve())}
+            return portable, load, run_key(portable)[:24]
         spec = entry.map_spec_for(seed)
         portable = dict(spec)
         load = dict(spec)
@@ -653,6 +658,31 @@ def load_map(spec: Mapping[str, Any], base_dir: str | os.PathLike[str] = ".") ->
     from pathfuse.io import map_from_spec
 
     return map_from_spec(dict(spec), base_dir)
+
+
+def load_dynamic(spec: Mapping[str, Any]) -> Any:
+    """The :class:`~pathfuse.world.Scenario` of a loadable dynamic spec.
+
+    ``{"dynamic": FILE}``, ``{"dynamic": {inline scenario}, "base_dir": DIR}`` or
+    ``{"dynamic": {"generate": {...}, "seed": S}}`` (scenario 0 of the family
+    :func:`pathfuse.world.generate.generate_scenarios` draws with seed ``S``).
+    """
+    from pathfuse.world import load_scenario
+
+    dyn = spec["dynamic"]
+    if isinstance(dyn, Mapping) and "generate" in dyn:
+        from pathfuse.world.generate import generate_scenarios
+
+        return generate_scenarios(1, seed=int(dyn["seed"]), **dict(dyn["generate"]))[0]
+    if isinstance(dyn, Mapping) and spec.get("base_dir"):
+        d = json.loads(canonical_json(dyn))
+        m = d.get("map")
+        if isinstance(m, Mapping):  # relative map files: against the experiment's folder
+            for fam in FILE_FAMILIES:
+                if isinstance(m.get(fam), str) and not Path(m[fam]).is_absolute():
+                    m[fam] = str(Path(spec["base_dir"]) / m[fam])
+        return load_scenario(d)
+    return load_scenario(dyn)
 
 
 def _load_for_expand(exp: Experiment, entry: MapEntry, where: str) -> Any:
@@ -792,6 +822,12 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
             if entry.kind == "static" and entry.scen is None:
                 grid = _load_for_expand(exp, entry, f"maps[{entry.index}]")
                 _check_queries(entry, grid)
+            elif entry.kind == "dynamic":
+                _, load, _ = exp._map_identity(entry, entry.seeds[0])
+                try:
+                    load_dynamic(load)
+                except PathfuseError as exc:
+                    raise ConfigError(f"maps[{entry.index}].dynamic: {exc}") from None
     return exp
 
 
@@ -990,6 +1026,8 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
             default_name = Path(dyn).stem
         elif isinstance(dyn, Mapping):
             dyn = _plain(dict(dyn))
+            if "generate" in dyn:
+                _check_generate(dyn, f"{where}.dynamic")
             default_name = f"dynamic-{i}"
         else:
             raise ConfigError(f"{where}.dynamic: expected a scenario file or a mapping, "
@@ -1074,6 +1112,23 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                     seeds=seeds, robot_radius_m=radius, queries=tuple(queries),
                     random_queries=random_q, scen=scen, lines=v.get("lines"),
                     pair_keys="start" in v or "goal" in v)
+
+
+def _check_generate(dyn: Mapping[str, Any], where: str) -> None:
+    """``{generate: {...}}`` holds arguments of ``generate_scenarios`` (pathfuse.world)."""
+    import inspect
+
+    from pathfuse.world.generate import generate_scenarios
+
+    if set(dyn) != {"generate"} or not isinstance(dyn["generate"], Mapping):
+        raise ConfigError(f"{where}: expected {{generate: {{moving: K, speed_range: [lo, hi], "
+                          f"...}}}} alone, got {_short(dict(dyn))}")
+    allowed = [p for p in inspect.signature(generate_scenarios).parameters
+               if p not in ("n_scenarios", "seed")]
+    for k in dyn["generate"]:
+        if k not in allowed:
+            raise ConfigError(f"{where}.generate.{k}: unknown argument; expected one of "
+                              f"{', '.join(allowed)} (the run's seed is the family seed)")
 
 
 def _entry_name(v: Mapping[str, Any], where: str, default: str) -> str:

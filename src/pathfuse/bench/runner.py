@@ -23,6 +23,7 @@ complete.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import multiprocessing as mp
 import os
@@ -49,9 +50,10 @@ from pathfuse.bench.experiment import (
 )
 from pathfuse.bench.progress import ProgressBar
 from pathfuse.bench.store import ResultStore
-from pathfuse.result import ConfigError
+from pathfuse.result import ConfigError, PathfuseError
 
-__all__ = ["run_bench", "SweepSummary", "SweepInterrupted", "make_batches", "default_workers"]
+__all__ = ["run_bench", "SweepSummary", "SweepInterrupted", "WorkersCannotStart", "make_batches",
+           "default_workers"]
 
 CRASH_TEXT = ("WorkerCrashed: the worker process died while running this run "
               "(segfault, os._exit, out of memory or killed)")
@@ -276,10 +278,58 @@ def _mp_context() -> Any:
     return mp.get_context("spawn")
 
 
+def _ping() -> int:
+    return os.getpid()
+
+
+@contextlib.contextmanager
+def _main_without_file() -> Any:
+    """Hide ``__main__.__file__`` when it is no file (``python - < script``, REPL tools).
+
+    Fork-server and spawn workers re-import the main script by its path; a
+    main read from stdin has none, and every worker would die at start.  The
+    workers run only pathfuse code, so they do not need the main module.
+    """
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    hide = path is not None and getattr(main, "__spec__", None) is None and \
+        not os.path.isfile(path)
+    if hide:
+        del main.__file__  # type: ignore[union-attr]
+    try:
+        yield
+    finally:
+        if hide:
+            main.__file__ = path  # type: ignore[union-attr]
+
+
+class WorkersCannotStart(PathfuseError):
+    """The worker processes die before running anything (an import error, a bad plug-in)."""
+
+
 class _Pool:
+    """A process pool whose workers are started (and checked) before it is used."""
+
     def __init__(self, workers: int, imports: Sequence[str]) -> None:
         self.ex = ProcessPoolExecutor(max_workers=workers, mp_context=_mp_context(),
                                       initializer=_worker_init, initargs=(list(imports),))
+        try:
+            pings = [self.ex.submit(_ping) for _ in range(workers)]
+            for f in pings:
+                f.result(timeout=300)
+        except BrokenProcessPool:
+            self.kill()
+            raise WorkersCannotStart(
+                "the worker processes die as they start (see the errors above); run with "
+                "workers=1 to see the problem in this process") from None
+
+    def submit(self, payload: dict[str, Any]) -> Future:
+        try:
+            return self.ex.submit(execute_batch, payload)
+        except (BrokenProcessPool, RuntimeError) as exc:  # broke since the last check
+            f: Future = Future()
+            f.set_exception(BrokenProcessPool(str(exc)))
+            return f
 
     def kill(self) -> None:
         procs = list(getattr(self.ex, "_processes", {}).values())
@@ -301,7 +351,7 @@ def _run_pool(exp: Experiment, todo: Sequence[RunSpec], sink: _Sink, workers: in
         while pending or in_flight:
             while pending and len(in_flight) < 2 * workers:
                 b = pending.popleft()
-                in_flight[pool.ex.submit(execute_batch, _batch_payload(exp, b))] = b
+                in_flight[pool.submit(_batch_payload(exp, b))] = b
             done, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
             broken: list[list[list[RunSpec]]] = []
             for f in done:
@@ -337,7 +387,7 @@ def _isolate(exp: Experiment, runs: Sequence[RunSpec], sink: _Sink,
     pool = _Pool(1, imports)
     try:
         for r in runs:
-            fut = pool.ex.submit(execute_batch, _batch_payload(exp, [[r]]))
+            fut = pool.submit(_batch_payload(exp, [[r]]))
             try:
                 rows = fut.result()
             except BrokenProcessPool:
@@ -541,7 +591,8 @@ def run_bench(
             elif nworkers == 1 or len(todo) == 1:
                 _run_serial(exp, todo, sink)
             else:
-                _run_pool(exp, todo, sink, nworkers, batch_size)
+                with _main_without_file():
+                    _run_pool(exp, todo, sink, nworkers, batch_size)
             state = "finished"
         except KeyboardInterrupt:
             state = "interrupted"

@@ -173,3 +173,32 @@ def test_schema_is_documented():
     assert WALL_CLOCK_COLUMNS <= {c for c, _, _ in RUN_COLUMNS}
     md = schema_markdown()
     assert md.count("\n") == len(RUN_COLUMNS) + 1 and "`R_length`" in md
+
+
+def test_queries_of_ompl_style_readers_work(st):
+    """The queries a reader written for OMPL's databases makes (columns by declared type)."""
+    e = st.ensure_experiment("s", "paper", "static", timelimit=5.0, runcount=2)
+    p1 = st.ensure_planner_config("astar", "astar", "{}")
+    p2 = st.ensure_planner_config("apf", "apf", "{}")
+    st.insert_runs([_row("a", e, p1), _row("b", e, p2, status_name="LOCAL_MINIMUM",
+                                             solved=False, solution_length=None)])
+    c = st.conn
+    planners = c.execute("SELECT id, name FROM plannerConfigs").fetchall()
+    cols = c.execute("PRAGMA table_info(runs)").fetchall()[3:]
+    plotted = [(col[1], col[2]) for col in cols if col[2] in ("BOOLEAN", "ENUM", "INTEGER",
+                                                              "REAL")]
+    assert ("time", "REAL") in plotted and ("status", "ENUM") in plotted
+    for name, _ in plotted:
+        for pid, _ in planners:
+            c.execute(f'SELECT "{name}" FROM runs WHERE plannerid = ? AND "{name}" IS NOT NULL',
+                      (pid,)).fetchall()
+    descriptions = [r[0] for r in c.execute(
+        "SELECT description FROM enums WHERE name IS 'status' ORDER BY value")]
+    used = [r[0] for r in c.execute("SELECT status FROM runs ORDER BY id")]
+    assert [descriptions[v] for v in used] == ["SUCCESS", "LOCAL_MINIMUM"]
+    exp = c.execute("SELECT id, name, timelimit, memorylimit FROM experiments").fetchall()
+    assert [tuple(r) for r in exp] == [(e, "s/paper", 5.0, 0.0)]
+    per = c.execute("SELECT count(*) FROM runs WHERE runs.experimentid = ? "
+                    "GROUP BY runs.plannerid", (e,)).fetchall()
+    assert [r[0] for r in per] == [1, 1]
+    assert [r[1] for r in c.execute("PRAGMA table_info(progress)")][:2] == ["runid", "time"]

@@ -96,12 +96,15 @@ def test_bad_queries(name, start, goal, status):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_unreachable_goal(name):
+    spec = get_planner(name)
+    if spec.warmup is not None:  # keep a cold numba cache out of the wall-clock check
+        spec.warmup()
     t0 = time.perf_counter()
     r = plan(BOX, (0.5, 0.5), (5.5, 2.5), planner=name)
     wall = time.perf_counter() - t0
     check_bookkeeping(r, name)
     assert not r.success
-    if get_planner(name).uses_astar:
+    if spec.uses_astar:
         assert r.status is Status.NO_PATH and r.path.shape == (0, 2)
     else:
         assert r.status in (Status.LOCAL_MINIMUM, Status.NO_PATH)

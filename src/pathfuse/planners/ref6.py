@@ -54,7 +54,9 @@ failures) from step 1; ``LOCAL_MINIMUM`` when the robot stalls or is blocked
 on the way to any sub-goal (the partial path is returned, the plan is not
 continued past a failed sub-problem); ``MAX_ITERATIONS`` after
 ``Budget.max_iterations`` force steps in all; ``TIMEOUT`` after
-``Budget.time_limit_s`` (A* included).  ``time_s`` includes A*.
+``Budget.time_limit_s`` (A* included).  ``time_s`` is A*'s search time
+plus the wall time of finding the inflection points and stepping (the convention of
+:mod:`pathfuse.planners.fusion`, so that times compare).
 
 ``info``: ``astar_path`` (the A* path, cell centres), ``astar_length``,
 ``astar_time_s``, ``subgoals`` (K, 2) (the inflection points in order, then
@@ -419,20 +421,22 @@ def follow_subgoals(
     subgoals: np.ndarray,
     params: Ref6Params | None = None,
     budget: Budget | None = None,
-    t0: float | None = None,
+    *,
+    deadline: float | None = None,
 ) -> PlanResult:
     """Step 3 of ref [6] alone: improved APF from ``start`` through ``subgoals`` to ``goal``.
 
     ``subgoals`` (K, 2) are visited in order; ``goal`` is appended when it is
-    not their last point.  ``t0`` is the ``perf_counter`` time the plan
-    started (defaults to now); the time limit and ``time_s`` count from it.
+    not their last point.  ``deadline`` is the ``perf_counter`` value at
+    which the plan ends with ``TIMEOUT`` (default: ``Budget.time_limit_s``
+    from now).  ``time_s`` is the wall time of this call.
 
     >>> g = GridMap.from_rows(["....", "....", "...."])
     >>> r = follow_subgoals(g, np.array([0.5, 0.5]), np.array([3.5, 0.5]), [[1.5, 2.5]])
     >>> r.status.name, r.info["subgoals_reached"], bool(r.path[:, 1].max() > 2.0)
     ('SUCCESS', 2, True)
     """
-    t0 = time.perf_counter() if t0 is None else t0
+    t0 = time.perf_counter()
     p = params or Ref6Params()
     budget = budget or Budget()
     start = np.asarray(start, dtype=np.float64).reshape(2)
@@ -446,7 +450,8 @@ def follow_subgoals(
     sub_tol = (float(p.subgoal_tolerance_m) if p.subgoal_tolerance_m is not None
                else 0.5 * grid.resolution)
     scale = float(p.rep_scale_m) if p.rep_scale_m is not None else float(p.rho0_m)
-    deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
+    if deadline is None and budget.time_limit_s is not None:
+        deadline = t0 + budget.time_limit_s
     ox, oy = grid.origin
     cfg = pack_ref6(goal, p.k_att, p.k_rep, p.rho0_m, st.step_m, st.goal_tolerance_m,
                     st.clear_m, st.stall_distance_m, ox, oy, grid.resolution, sub_tol,
@@ -486,8 +491,11 @@ def plan_ref6(
 ) -> PlanResult:
     """Plan with reference method [6]: A*, then improved APF through its inflection points.
 
-    ``Budget.max_iterations`` caps the APF steps (A* runs with the time limit
-    only); ``Budget.time_limit_s`` covers both.
+    ``time_s`` is A*'s ``time_s`` (its search; per-map preparation such as
+    growing the map by ``robot_radius_m`` is left out, as for the ``astar``
+    and ``fusion`` planners) plus the wall time of finding the inflection
+    points and stepping.  ``Budget.max_iterations`` caps the APF steps (A*
+    runs with the time limit only); ``Budget.time_limit_s`` covers both.
     """
     from pathfuse.planners.astar import AStarParams, plan_astar
 
@@ -496,18 +504,22 @@ def plan_ref6(
     budget = budget or Budget()
     start = np.asarray(start, dtype=np.float64).reshape(2)
     goal = np.asarray(goal, dtype=np.float64).reshape(2)
+    deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
     agrid = grid.inflate(p.robot_radius_m) if p.robot_radius_m > 0 else grid
     ares = plan_astar(agrid, start, goal, AStarParams(), Budget(time_limit_s=budget.time_limit_s))
-    t_astar = time.perf_counter() - t0
     apath = np.asarray(ares.path, dtype=np.float64).reshape(-1, 2)
-    base = {"astar_path": apath, "astar_length": float(ares.length), "astar_time_s": t_astar}
+    base = {"astar_path": apath, "astar_length": float(ares.length),
+            "astar_time_s": float(ares.time_s)}
     if not ares.success:
-        return PlanResult(ares.status, np.zeros((0, 2)), 0.0, time.perf_counter() - t0, "ref6",
+        return PlanResult(ares.status, np.zeros((0, 2)), 0.0, ares.time_s, "ref6",
                           ares.expansions, 0, f"A* failed: {ares.message}",
                           {**base, "subgoals": np.zeros((0, 2))})
-    res = follow_subgoals(grid, start, goal, inflection_points(apath), p, budget, t0)
+    t1 = time.perf_counter()
+    res = follow_subgoals(grid, start, goal, inflection_points(apath), p, budget,
+                          deadline=deadline)
+    elapsed = time.perf_counter() - t1
     res.info.update(base)
-    return PlanResult(res.status, res.path, res.length, time.perf_counter() - t0, "ref6",
+    return PlanResult(res.status, res.path, res.length, ares.time_s + elapsed, "ref6",
                       ares.expansions, res.iterations, res.message, res.info)
 
 

@@ -33,7 +33,8 @@ failures) from step 1; ``LOCAL_MINIMUM`` when a local APF stalls or is blocked
 (the partial path is returned and the remaining segments are not planned);
 ``MAX_ITERATIONS`` after ``Budget.max_iterations`` force steps over all
 segments; ``TIMEOUT`` after ``Budget.time_limit_s`` (A* included).
-``time_s`` includes A*.
+``time_s`` is A*'s search time plus the wall time of cutting the path and stepping
+(the convention of :mod:`pathfuse.planners.fusion`, so that times compare).
 
 ``info``: ``astar_path``, ``astar_length``, ``astar_time_s``, ``segments``
 (K, 2) (the segment end points in order, the goal last),
@@ -173,19 +174,22 @@ def follow_segments(
     ends: np.ndarray,
     params: Ref7Params | None = None,
     budget: Budget | None = None,
-    t0: float | None = None,
+    *,
+    deadline: float | None = None,
 ) -> PlanResult:
     """Step 3 of ref [7] alone: plain APF from ``start`` to each of ``ends`` (K, 2) in turn.
 
-    ``goal`` is appended to ``ends`` when it is not their last point.  ``t0``
-    is the ``perf_counter`` time the plan started (defaults to now).
+    ``goal`` is appended to ``ends`` when it is not their last point.
+    ``deadline`` is the ``perf_counter`` value at which the plan ends with
+    ``TIMEOUT`` (default: ``Budget.time_limit_s`` from now).  ``time_s`` is
+    the wall time of this call.
 
     >>> g = GridMap.from_rows(["....", "....", "...."])
     >>> r = follow_segments(g, np.array([0.5, 0.5]), np.array([3.5, 0.5]), [[1.5, 2.5]])
     >>> r.status.name, r.info["segments_done"], r.path[r.info["joints"]].tolist()
     ('SUCCESS', 2, [[1.5, 2.5], [3.5, 0.5]])
     """
-    t0 = time.perf_counter() if t0 is None else t0
+    t0 = time.perf_counter()
     p = params or Ref7Params()
     budget = budget or Budget()
     start = np.asarray(start, dtype=np.float64).reshape(2)
@@ -197,7 +201,8 @@ def follow_segments(
                           p.robot_radius_m, budget.max_iterations)
     seg_tol = (float(p.segment_tolerance_m) if p.segment_tolerance_m is not None
                else 0.5 * grid.resolution)
-    deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
+    if deadline is None and budget.time_limit_s is not None:
+        deadline = t0 + budget.time_limit_s
     ox, oy = grid.origin
     occ = grid.occupied
     pieces = [start[None, :]]
@@ -271,8 +276,11 @@ def plan_ref7(
 ) -> PlanResult:
     """Plan with reference method [7]: A*, cut into segments, plain APF segment by segment.
 
-    ``Budget.max_iterations`` caps the APF steps over all segments (A* runs
-    with the time limit only); ``Budget.time_limit_s`` covers both.
+    ``time_s`` is A*'s ``time_s`` (its search; per-map preparation such as
+    growing the map by ``robot_radius_m`` is left out, as for the ``astar``
+    and ``fusion`` planners) plus the wall time of cutting the path and
+    stepping.  ``Budget.max_iterations`` caps the APF steps over all segments
+    (A* runs with the time limit only); ``Budget.time_limit_s`` covers both.
     """
     from pathfuse.planners.astar import AStarParams, plan_astar
 
@@ -281,22 +289,25 @@ def plan_ref7(
     budget = budget or Budget()
     start = np.asarray(start, dtype=np.float64).reshape(2)
     goal = np.asarray(goal, dtype=np.float64).reshape(2)
+    deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
     agrid = grid.inflate(p.robot_radius_m) if p.robot_radius_m > 0 else grid
     ares = plan_astar(agrid, start, goal, AStarParams(), Budget(time_limit_s=budget.time_limit_s))
-    t_astar = time.perf_counter() - t0
     apath = np.asarray(ares.path, dtype=np.float64).reshape(-1, 2)
-    base = {"astar_path": apath, "astar_length": float(ares.length), "astar_time_s": t_astar}
+    base = {"astar_path": apath, "astar_length": float(ares.length),
+            "astar_time_s": float(ares.time_s)}
     if not ares.success:
-        return PlanResult(ares.status, np.zeros((0, 2)), 0.0, time.perf_counter() - t0, "ref7",
+        return PlanResult(ares.status, np.zeros((0, 2)), 0.0, ares.time_s, "ref7",
                           ares.expansions, 0, f"A* failed: {ares.message}",
                           {**base, "segments": np.zeros((0, 2)),
                            "segment_index": np.zeros(0, dtype=np.int64)})
+    t1 = time.perf_counter()
     idx = segment_ends(apath, p.segment_length_m, p.segment_points)
     ends = apath[idx]
     ends[-1] = goal  # the last A* point is the goal's cell centre: end at the goal itself
-    res = follow_segments(grid, start, goal, ends, p, budget, t0)
+    res = follow_segments(grid, start, goal, ends, p, budget, deadline=deadline)
+    elapsed = time.perf_counter() - t1
     res.info.update(base, segment_index=idx)
-    return PlanResult(res.status, res.path, res.length, time.perf_counter() - t0, "ref7",
+    return PlanResult(res.status, res.path, res.length, ares.time_s + elapsed, "ref7",
                       ares.expansions, res.iterations, res.message, res.info)
 
 

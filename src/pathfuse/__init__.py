@@ -9,6 +9,18 @@ True
 
 from pathfuse.api import plan
 from pathfuse.grid import GridMap
+from pathfuse.io import (
+    load_map,
+    map_from_spec,
+    read_image,
+    read_movingai,
+    read_npy,
+    read_ros_map,
+    read_rows_yaml,
+    read_scen,
+    write_movingai,
+    write_ros_map,
+)
 from pathfuse.planners.registry import REGISTRY, get_planner, planner_names
 from pathfuse.result import (
     Budget,
@@ -21,6 +33,8 @@ from pathfuse.result import (
     QueryError,
     Status,
 )
+
+from pathfuse.world import Episode, EpisodeStatus, World, load_scenario, simulate
 
 __version__ = "0.1.0"
 
@@ -39,5 +53,20 @@ __all__ = [
     "REGISTRY",
     "get_planner",
     "planner_names",
+    "load_map",
+    "map_from_spec",
+    "read_movingai",
+    "write_movingai",
+    "read_scen",
+    "read_ros_map",
+    "write_ros_map",
+    "read_image",
+    "read_npy",
+    "read_rows_yaml",
+    "simulate",
+    "World",
+    "Episode",
+    "EpisodeStatus",
+    "load_scenario",
     "__version__",
 ]

@@ -20,8 +20,13 @@ maps:
   - name: file
     map: {movingai: small.map}
     queries: [{start: [0.5, 0.5], goal: [5.5, 3.5]}, {start: [0.5, 3.5], goal: [5.5, 0.5]}]
+  - name: moving
+    dynamic: sc.yaml
+    seeds: 2
 planners:
   - tdij
+  - name: astar-follow
+    kinds: [dynamic]
   - name: tdij
     label: picky
     params: {sleep_s: [0.0, 0.001], raise_seed: 3}
@@ -35,6 +40,10 @@ def _study(tmp_path):
 
     (tmp_path / "tplug.py").write_text(PLUGIN)
     (tmp_path / "small.map").write_text(SMALL_MAP)
+    (tmp_path / "sc.yaml").write_text(
+        'map: {rows: ["..........", "..........", ".........."]}\nstart: [0.5, 1.5]\n'
+        'goal: [9.5, 1.5]\nrobot: {radius: 0.2}\n'
+        'obstacles: [{position: [5.0, 2.5], velocity: [0.0, -0.4], radius: 0.3}]\n')
     p = tmp_path / "exp.yaml"
     p.write_text(STUDY)
     return p
@@ -51,7 +60,7 @@ def test_dask_cluster_results_equal_local_results(tmp_path):
                            progress=False, batch_size=3)
         again = run_bench(exp, tmp_path / "dask.db", scheduler=cluster.scheduler_address,
                           progress=False)
-    assert remote.total == local.total == 4 * 3 * 3
+    assert remote.total == local.total == 4 * 3 * 3 + 2
     assert remote.ran == remote.total and again.ran == 0
     assert remote.errors == local.errors == 2 * 3  # seed 3 raises in the two picky configs
     assert remote.workers == 2 and remote.scheduler == cluster.scheduler_address

@@ -401,7 +401,9 @@ def _scenario(group: Mapping[str, Any]) -> Any:
     key = (group["map_key"], "scenario")
     with _LOCK:
         if key not in _MAPS:
-            _lru_put(_MAPS, key, load_dynamic(group["map_spec"]), _MAP_CACHE_SIZE)
+            sc = group.get("grid")  # shipped by a Dask client
+            _lru_put(_MAPS, key, sc if sc is not None else load_dynamic(group["map_spec"]),
+                     _MAP_CACHE_SIZE)
         return _MAPS[key]
 
 

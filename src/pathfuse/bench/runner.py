@@ -40,11 +40,13 @@ from typing import Any
 
 from pathfuse.bench.execute import ensure_imports, execute_batch, execute_run
 from pathfuse.bench.experiment import (
+    FILE_FAMILIES,
     Experiment,
     RunSpec,
     canonical_json,
     file_digest,
     iter_groups,
+    load_dynamic,
     load_experiment,
     load_map,
 )
@@ -452,10 +454,14 @@ def _run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: _Sink, scheduler: 
         # made on the workers from their spec
         grids: dict[str, Any] = {}
         for r in todo:
-            if r.kind == "static" and r.map_key not in grids and r.map_spec and \
-                    any(f in r.map_spec for f in ("movingai", "ros", "image")):
-                grid = load_map(r.map_spec, exp.base_dir)
-                grids[r.map_key] = client.scatter(grid, broadcast=False, hash=True)
+            if r.map_key in grids or not r.map_spec:
+                continue
+            if r.kind == "static" and any(f in r.map_spec for f in FILE_FAMILIES):
+                grids[r.map_key] = client.scatter(load_map(r.map_spec, exp.base_dir),
+                                                  broadcast=False, hash=True)
+            elif r.kind == "dynamic" and isinstance(r.map_spec.get("dynamic"), str):
+                grids[r.map_key] = client.scatter(load_dynamic(r.map_spec),
+                                                  broadcast=False, hash=True)
         index: dict[Any, list[list[RunSpec]]] = {}
         for b in make_batches(todo, nworkers, batch_size):
             f = client.submit(execute_batch, _batch_payload(exp, b, grids), pure=False)

@@ -14,10 +14,9 @@ fusion and the reference succeeded, with that count printed beside them.
 
 from __future__ import annotations
 
-import csv
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -28,6 +27,9 @@ from pathfuse.api import plan
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import evaluate, r_ratio
 from pathfuse.result import ConfigError
+from pathfuse.stats import markdown_table as _md
+from pathfuse.stats import mean_ci, wilson_ci
+from pathfuse.stats import write_csv as _write_csv
 
 __all__ = [
     "PAPER_PLANNERS",
@@ -160,45 +162,6 @@ def run_paper(
 
 
 # --------------------------------------------------------------------------- statistics
-def mean_ci(values: Sequence[float], level: float = 0.95) -> tuple[float, float, float]:
-    """Mean and Student-t confidence interval of the mean: (mean, low, high).
-
-    NaN for an empty sample; a zero-width interval for one value.
-
-    >>> m, lo, hi = mean_ci([1.0, 2.0, 3.0])
-    >>> m, round(lo, 3), round(hi, 3)
-    (2.0, -0.484, 4.484)
-    """
-    x = np.asarray(values, dtype=float)
-    if x.size == 0:
-        return (math.nan, math.nan, math.nan)
-    m = float(x.mean())
-    if x.size == 1:
-        return (m, m, m)
-    from scipy import stats
-
-    half = float(stats.t.ppf(0.5 + level / 2, x.size - 1) * x.std(ddof=1) / math.sqrt(x.size))
-    return (m, m - half, m + half)
-
-
-def wilson_ci(successes: int, n: int, level: float = 0.95) -> tuple[float, float, float]:
-    """Success rate with a Wilson score interval: (rate, low, high).
-
-    >>> [round(v, 4) for v in wilson_ci(95, 100)]
-    [0.95, 0.8882, 0.9785]
-    """
-    if n == 0:
-        return (math.nan, math.nan, math.nan)
-    from scipy import stats
-
-    z = float(stats.norm.ppf(0.5 + level / 2))
-    p = successes / n
-    den = 1 + z * z / n
-    centre = (p + z * z / (2 * n)) / den
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return (p, max(0.0, centre - half), min(1.0, centre + half))
-
-
 def _paired(run: PaperRun, ref: str, key: str) -> np.ndarray:
     """R = (fusion - ref) / ref on the seeds where both succeeded."""
     fus = {r["seed"]: r for r in run.by_planner("fusion")}
@@ -351,22 +314,6 @@ def _stats_tables(run: PaperRun, rows: list[dict[str, Any]]) -> str:
         "Times are wall-clock planning times in this process (A* included for the planners "
         "that use it; numba compilation excluded by a warm-up call before timing).\n"
     )
-
-
-def _md(table: list[list[str]]) -> str:
-    out = ["| " + " | ".join(table[0]) + " |", "|" + "---|" * len(table[0])]
-    out += ["| " + " | ".join(str(c) for c in row) + " |" for row in table[1:]]
-    return "\n".join(out)
-
-
-def _write_csv(path: Path, rows: list[dict[str, Any]] | list[list[Any]]) -> None:
-    with open(path, "w", newline="") as fh:
-        if rows and isinstance(rows[0], dict):
-            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-            w.writeheader()
-            w.writerows(rows)  # type: ignore[arg-type]
-        else:
-            csv.writer(fh).writerows(rows)  # type: ignore[arg-type]
 
 
 def write_paper_outputs(run: PaperRun, out_dir: str | Path) -> dict[str, Path]:

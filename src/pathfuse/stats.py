@@ -1,0 +1,87 @@
+"""Small statistics and table helpers shared by the benchmarks.
+
+* :func:`mean_ci` - a mean with its Student-t confidence interval;
+* :func:`wilson_ci` - a success rate with its Wilson score interval;
+* :func:`markdown_table` - a list of rows as a GitHub Markdown table;
+* :func:`write_csv` - dict rows (or plain rows) to a CSV file.
+
+Used by :mod:`pathfuse.paper` (static reproduction) and :mod:`pathfuse.dynamic`
+(the moving-obstacle benchmark).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["mean_ci", "wilson_ci", "markdown_table", "write_csv"]
+
+
+def mean_ci(values: Sequence[float], level: float = 0.95) -> tuple[float, float, float]:
+    """Mean and Student-t confidence interval of the mean: (mean, low, high).
+
+    NaN for an empty sample; a zero-width interval for one value.
+
+    >>> m, lo, hi = mean_ci([1.0, 2.0, 3.0])
+    >>> m, round(lo, 3), round(hi, 3)
+    (2.0, -0.484, 4.484)
+    """
+    x = np.asarray(values, dtype=float)
+    if x.size == 0:
+        return (math.nan, math.nan, math.nan)
+    m = float(x.mean())
+    if x.size == 1:
+        return (m, m, m)
+    from scipy import stats
+
+    half = float(stats.t.ppf(0.5 + level / 2, x.size - 1) * x.std(ddof=1) / math.sqrt(x.size))
+    return (m, m - half, m + half)
+
+
+def wilson_ci(successes: int, n: int, level: float = 0.95) -> tuple[float, float, float]:
+    """Success rate with a Wilson score interval: (rate, low, high).
+
+    NaN for ``n == 0``.
+
+    >>> [round(v, 4) for v in wilson_ci(95, 100)]
+    [0.95, 0.8882, 0.9785]
+    """
+    if n == 0:
+        return (math.nan, math.nan, math.nan)
+    from scipy import stats
+
+    z = float(stats.norm.ppf(0.5 + level / 2))
+    p = successes / n
+    den = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / den
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return (p, max(0.0, centre - half), min(1.0, centre + half))
+
+
+def markdown_table(table: Sequence[Sequence[Any]]) -> str:
+    """A GitHub Markdown table; ``table[0]`` is the header row.
+
+    >>> print(markdown_table([["a", "b"], [1, 2]]))
+    | a | b |
+    |---|---|
+    | 1 | 2 |
+    """
+    out = ["| " + " | ".join(str(c) for c in table[0]) + " |", "|" + "---|" * len(table[0])]
+    out += ["| " + " | ".join(str(c) for c in row) + " |" for row in table[1:]]
+    return "\n".join(out)
+
+
+def write_csv(path: str | Path, rows: Sequence[dict[str, Any]] | Sequence[Sequence[Any]]) -> None:
+    """Write dict rows (header = the first row's keys) or plain rows to ``path``."""
+    with open(path, "w", newline="") as fh:
+        if rows and isinstance(rows[0], dict):
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)  # type: ignore[arg-type]
+        else:
+            csv.writer(fh).writerows(rows)  # type: ignore[arg-type]

@@ -34,6 +34,34 @@ from pathfuse.bench import run_bench
 REPO = Path(__file__).resolve().parents[1]
 
 
+def _spin(n: int) -> int:
+    s = 0
+    for i in range(n):
+        s += i * i
+    return s
+
+
+def machine_speedup(workers: int, n: int = 2_000_000, tasks: int = 8) -> float:
+    """Speed-up of a pure-Python CPU loop with ``workers`` processes right now.
+
+    What the machine can give at all (other jobs share the cores): the ceiling
+    for the sweep's speed-up.
+    """
+    import time
+    from concurrent.futures import ProcessPoolExecutor
+
+    t = time.perf_counter()
+    for _ in range(tasks):
+        _spin(n)
+    serial = time.perf_counter() - t
+    with ProcessPoolExecutor(workers) as ex:
+        list(ex.map(_spin, [10] * workers))
+        t = time.perf_counter()
+        list(ex.map(_spin, [n] * tasks))
+        par = time.perf_counter() - t
+    return serial / par
+
+
 def steady_rate(db: Path) -> float:
     with sqlite3.connect(db) as c:
         n, t0, t1 = c.execute("SELECT COUNT(*), MIN(started_at), MAX(finished_at) "
@@ -74,7 +102,9 @@ def main(argv: list[str] | None = None) -> int:
     for w in counts:
         r = results[w]
         print(f"speed-up with {w} workers: total {r[0] / base[0]:.2f}x  "
-              f"steady {r[1] / base[1]:.2f}x")
+              f"steady {r[1] / base[1]:.2f}x  (a pure CPU loop gets "
+              f"{machine_speedup(w):.2f}x on this machine now)")
+    print(f"load average at the end: {os.getloadavg()[0]:.2f}")
     return 0
 
 

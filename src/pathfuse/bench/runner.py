@@ -603,6 +603,7 @@ def run_bench(
         except KeyboardInterrupt:
             state = "interrupted"
             summary.interrupted = True
+            summary.wall_s = time.perf_counter() - t0
             raise SweepInterrupted(summary) from None
         finally:
             bar.close()

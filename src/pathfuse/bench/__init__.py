@@ -1,12 +1,34 @@
 """Benchmark sweeps at scale: experiment files, a SQLite result store, parallel runs.
 
->>> from pathfuse.bench import run_bench, load_experiment, ResultStore  # doctest: +SKIP
-
 * :mod:`pathfuse.bench.experiment` - the YAML experiment format and its run list;
 * :mod:`pathfuse.bench.store` - the OMPL-layout SQLite result store;
 * :mod:`pathfuse.bench.runner` - :func:`run_bench` (local pool or Dask);
 * :mod:`pathfuse.bench.execute` - what a worker runs;
 * :mod:`pathfuse.bench.progress` - the progress bar.
+
+Examples
+--------
+>>> import pathlib, shutil, tempfile
+>>> d = pathlib.Path(tempfile.mkdtemp())
+>>> _ = (d / "exp.yaml").write_text('''
+... seeds: 3
+... maps:
+...   - map: {rows: ["....", ".##.", "...."]}
+...     start: [0.5, 0.5]
+...     goal: [3.5, 2.5]
+... planners: [astar]
+... ''')
+>>> s = run_bench(d / "exp.yaml", d / "study.db", workers=1, progress=False)
+>>> s.ran, s.succeeded, s.errors
+(3, 3, 0)
+>>> again = run_bench(d / "exp.yaml", d / "study.db", workers=1, progress=False)
+>>> again.ran, again.skipped                    # resumed: nothing left to run
+(0, 3)
+>>> with ResultStore(d / "study.db", readonly=True) as st:
+...     rows = st.results()
+>>> sorted({(r["config"], r["status_text"], r["R_length"]) for r in rows})  # A* is the reference
+[('astar', 'SUCCESS', 0.0)]
+>>> shutil.rmtree(d)
 """
 
 from pathfuse.bench.experiment import Experiment, RunSpec, load_experiment, parse_experiment

@@ -23,7 +23,6 @@ import importlib.util
 import json
 import math
 import os
-import resource
 import socket
 import sys
 import threading
@@ -123,13 +122,23 @@ def execute_run(group: Mapping[str, Any], run: Mapping[str, Any],
     row["wall_time"] = time.perf_counter() - t0
     row["started_at"] = started.isoformat(timespec="microseconds")
     row["finished_at"] = datetime.now(timezone.utc).isoformat(timespec="microseconds")
-    row["memory"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    row["memory"] = _peak_rss_mb()
     row["host"] = socket.gethostname()
     row["worker"] = _worker_name()
     from pathfuse import __version__
 
     row["pathfuse_version"] = __version__
     return row
+
+
+def _peak_rss_mb() -> float | None:
+    """Peak resident memory of this process in MB (None where unknown)."""
+    try:
+        import resource
+    except ImportError:  # not POSIX
+        return None
+    kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return kb / (1024.0 * 1024.0) if sys.platform == "darwin" else kb / 1024.0
 
 
 def _worker_name() -> str:

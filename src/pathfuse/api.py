@@ -99,7 +99,7 @@ def plan(
     >>> g = GridMap.from_rows(["....", ".##.", "...."])
     >>> r = plan(g, (0.5, 0.5), (3.5, 2.5))
     >>> r.status.name, round(r.length, 4)
-    ('SUCCESS', 3.8284)
+    ('SUCCESS', 5.0)
     >>> plan(g, (1.5, 1.5), (3.5, 2.5)).status.name
     'START_OCCUPIED'
     """

@@ -16,6 +16,8 @@ Examples
 >>> lines = out.getvalue().splitlines()
 >>> lines[-1].startswith("demo") and "4/4" in lines[-1] and "1 err" in lines[-1]
 True
+>>> ProgressBar(10, label="resumed", initial=6, enabled=False).line().split("]")[1].split()[:2]
+['6/10', '60%']
 """
 
 from __future__ import annotations
@@ -58,12 +60,16 @@ class ProgressBar:
         Minimum time between two writes (the final line is always written).
     width : int
         Characters of the bar itself.
+    initial : int
+        Runs already done before this session (a resumed sweep): counted in
+        ``done / total`` but not in the rate.
     """
 
     def __init__(self, total: int, label: str = "", stream: IO[str] | None = None,
                  enabled: bool = True, tty: bool | None = None, interval_s: float | None = None,
-                 width: int = 24) -> None:
+                 width: int = 24, initial: int = 0) -> None:
         self.total = max(0, int(total))
+        self.initial = max(0, int(initial))
         self.label = label
         self.stream = stream if stream is not None else sys.stderr
         self.enabled = enabled
@@ -73,7 +79,7 @@ class ProgressBar:
         self.tty = tty
         self.interval_s = (0.1 if tty else 10.0) if interval_s is None else interval_s
         self.width = width
-        self.done = 0
+        self.done = self.initial
         self.errors = 0
         self.t0 = time.perf_counter()
         self._last = -1e9
@@ -91,7 +97,7 @@ class ProgressBar:
         """The current status line."""
         now = time.perf_counter() if now is None else now
         el = max(now - self.t0, 1e-9)
-        rate = self.done / el
+        rate = (self.done - self.initial) / el
         left = (self.total - self.done) / rate if rate > 0 else float("inf")
         frac = self.done / self.total if self.total else 1.0
         fill = int(round(frac * self.width))

@@ -585,8 +585,8 @@ def run_bench(
             planned=len(runs), skipped=summary.skipped)
         enabled = bool(progress) if progress is not None else bool(
             getattr(stream or sys.stderr, "isatty", lambda: False)())
-        bar = ProgressBar(len(todo), label=exp.name, stream=stream, enabled=enabled and
-                          bool(todo))
+        bar = ProgressBar(len(runs), label=exp.name, stream=stream, enabled=enabled and
+                          bool(todo), initial=summary.skipped)
         sink = _Sink(store, exp, runs, summary, bar)
         state = "failed"
         try:

@@ -563,3 +563,23 @@ planners: [astar-follow, {name: apf, params: {k_att: [20, 40]}}]
         else:
             assert r["time_to_goal"] is None and r["solution_length"] is None
     assert {r["status_name"] for r in rows.values()} & {"REACHED"}
+
+
+def test_workers_that_cannot_start_stop_the_sweep_at_once(tmp_path):
+    from pathfuse.bench.runner import WorkersCannotStart
+
+    exp = paper_study(tmp_path, seeds=2)
+    # the plug-in imports in this process but fails in every worker process
+    (tmp_path / "tplug.py").write_text(PLUGIN + (
+        "\nimport multiprocessing\n"
+        "if multiprocessing.parent_process() is not None:\n"
+        "    raise ImportError('this plug-in refuses to load in a worker')\n"))
+    t0 = time.monotonic()
+    with pytest.raises(WorkersCannotStart, match="workers=1"):
+        run_bench(exp, tmp_path / "w.db", workers=2, progress=False)
+    assert time.monotonic() - t0 < 60
+    with ResultStore(tmp_path / "w.db", readonly=True) as st:
+        assert st.count() == 0
+        assert st.conn.execute("SELECT state FROM pathfuse_sessions").fetchone()[0] == "failed"
+    # in-process the same sweep runs
+    assert run_bench(exp, tmp_path / "w.db", workers=1, progress=False).errors == 0

@@ -174,8 +174,10 @@ def read_movingai(
     sizes: dict[str, int] = {}
     for _ in range(2):
         i += 1
-        if i >= len(lines):
-            raise MapFormatError(f"{path}, line {i + 1}: file ends inside the header")
+        if i >= len(lines) or not any(ln.strip() for ln in lines[i:]):
+            raise MapFormatError(
+                f"{path}, line {i + 1}: file ends inside the header (expected height and width)"
+            )
         key = lines[i].split()[:1]
         key_s = key[0].decode("ascii", "replace").lower() if key else ""
         if key_s not in ("height", "width") or key_s in sizes:
@@ -186,8 +188,10 @@ def read_movingai(
             )
         sizes[key_s] = _header_int(path, i + 1, key_s, lines[i])
     i += 1
-    if i >= len(lines) or lines[i].strip().lower() != b"map":
-        got = lines[i].decode("ascii", "replace") if i < len(lines) else "end of file"
+    if i >= len(lines) or not any(ln.strip() for ln in lines[i:]):
+        raise MapFormatError(f"{path}, line {i + 1}: file ends inside the header (expected 'map')")
+    if lines[i].strip().lower() != b"map":
+        got = lines[i].decode("ascii", "replace")
         raise MapFormatError(f"{path}, line {i + 1}: expected 'map', got {got!r}")
     height, width = sizes["height"], sizes["width"]
     first_row = i + 1
@@ -203,7 +207,7 @@ def read_movingai(
     for k, extra in enumerate(trailing):
         if extra.strip():
             raise MapFormatError(
-                f"{path}, line {first_row + height + k}: unexpected content after the "
+                f"{path}, line {first_row + height + k + 1}: unexpected content after the "
                 f"{height} map rows: {extra[:40].decode('ascii', 'replace')!r}"
             )
     grid = np.empty((height, width), dtype=np.bool_)

@@ -26,7 +26,7 @@ Examples
 >>> from pathfuse.world import simulate
 >>> ep = simulate({"map": {"rows": ["......"] * 3}, "start": [0.5, 1.5],
 ...                "goal": [5.5, 1.5]}, planner="astar-follow")
->>> ep.n_ticks, list(frame_ticks(ep.n_ticks, 20))
+>>> ep.n_ticks, frame_ticks(ep.n_ticks, 20).tolist()
 (48, [0, 20, 40, 48])
 >>> with tempfile.TemporaryDirectory() as d:
 ...     info = animate_episode(ep, os.path.join(d, "ep.gif"), frame_step=20, dpi=40)

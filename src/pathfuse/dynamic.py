@@ -135,7 +135,10 @@ class DynamicConfig:
             raise ConfigError(f"planners: expected a list of names, got {self.planners!r}")
         names = tuple(dict.fromkeys(self.planners)) or tuple(online_planner_names())
         for n in names:
-            get_online_planner(n)  # ConfigError listing the choices
+            try:
+                get_online_planner(n)
+            except ConfigError as exc:
+                raise ConfigError(f"planners: {exc}") from None
         object.__setattr__(self, "planners", names)
         if not isinstance(self.params, Mapping):
             raise ConfigError(f"params: expected {{planner: {{key: value}}}}, "

@@ -1,0 +1,186 @@
+"""The dynamic benchmark: episodes, counts, rates and intervals, files, determinism."""
+
+import csv
+import math
+import statistics
+
+import pytest
+from PIL import Image
+from scipy import stats as sps
+
+from pathfuse.dynamic import (
+    OUTCOMES,
+    DynamicConfig,
+    run_dynamic,
+    summary_rows,
+    write_dynamic_outputs,
+)
+from pathfuse.result import ConfigError
+from pathfuse.world import simulate
+from pathfuse.world.generate import generate_scenarios
+
+CFG = DynamicConfig(n_seeds=5, moving=(0, 3), speed_range=(0.4, 0.9),
+                    planners=("fusion", "astar-follow", "astar-replan"), seed=11)
+TIMING = {"mean_plan_time_s", "max_plan_time_s", "setup_time_s", "wall_s"}
+
+
+@pytest.fixture(scope="module")
+def run():
+    return run_dynamic(CFG)
+
+
+@pytest.fixture(scope="module")
+def files(run, tmp_path_factory):
+    return write_dynamic_outputs(run, tmp_path_factory.mktemp("dyn") / "out")
+
+
+def read_csv(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def wilson(k, n, z=1.959963984540054):
+    """Wilson score interval written out independently of pathfuse.stats."""
+    p = k / n
+    centre = (2 * k + z * z) / (2 * (n + z * z))
+    half = z * math.sqrt(n * p * (1 - p) + z * z / 4) / (n + z * z)
+    return p, max(0.0, centre - half), min(1.0, centre + half)
+
+
+def test_every_episode_is_recorded_once(run):
+    keys = [(r["moving"], r["index"], r["planner"]) for r in run.records]
+    assert len(keys) == len(set(keys)) == CFG.n_episodes == 5 * 2 * 3
+    assert {k[0] for k in keys} == {0, 3} and {k[1] for k in keys} == set(range(5))
+    assert {r["status"] for r in run.records} <= set(OUTCOMES)
+
+
+def test_records_are_the_episodes_of_pathfuse_simulate(run):
+    # regenerate the family independently and replay a few episodes directly
+    for k in CFG.moving:
+        scs = generate_scenarios(CFG.n_seeds, moving=k, speed_range=CFG.speed_range,
+                                 seed=CFG.seed)
+        assert all(len(sc.obstacles) == k for sc in scs)
+        for i in (0, CFG.n_seeds - 1):
+            for name in CFG.planners:
+                rec = next(r for r in run.records
+                           if (r["moving"], r["index"], r["planner"]) == (k, i, name))
+                ep = simulate(scs[i], planner=name)
+                assert rec["status"] == ep.status.name
+                assert rec["path_length_m"] == ep.path_length_m
+                assert rec["n_ticks"] == ep.n_ticks
+                assert rec["map"] == scs[i].grid.name
+                assert rec["reached"] == (ep.status.name == "REACHED")
+                assert (rec["time_to_goal_s"] is None) == (ep.time_to_goal_s is None)
+
+
+def test_counts_add_up(run):
+    rows = summary_rows(run)
+    assert len(rows) == len(CFG.moving) * len(CFG.planners)
+    for r in rows:
+        assert r["episodes"] == CFG.n_seeds
+        assert sum(r[k] for k in ("reached", "collision", "timeout", "local_minimum",
+                                  "no_path")) == r["episodes"]
+
+
+def test_summary_csv_agrees_with_an_independent_computation(files):
+    eps = read_csv(files["episodes_csv"])
+    summ = read_csv(files["summary_csv"])
+    assert len(eps) == CFG.n_episodes
+    assert len(summ) == len(CFG.moving) * len(CFG.planners)
+    names = {"REACHED": "reached", "COLLISION": "collision", "TIMEOUT": "timeout",
+             "LOCAL_MINIMUM": "local_minimum", "NO_PATH": "no_path"}
+    for row in summ:
+        mine = [e for e in eps if e["moving"] == row["moving"] and e["planner"] == row["planner"]]
+        n = len(mine)
+        assert int(row["episodes"]) == n == CFG.n_seeds
+        total = 0
+        for status, key in names.items():
+            k = sum(e["status"] == status for e in mine)
+            total += k
+            assert int(row[key]) == k
+            p, lo, hi = wilson(k, n)
+            assert float(row[f"{key}_rate"]) == pytest.approx(p, abs=1e-12)
+            assert float(row[f"{key}_ci_low"]) == pytest.approx(lo, abs=1e-9)
+            assert float(row[f"{key}_ci_high"]) == pytest.approx(hi, abs=1e-9)
+        assert total == n
+        ok = [e for e in mine if e["status"] == "REACHED"]
+        for col, label, unit in (("path_length_m", "path_length", "m"),
+                                 ("time_to_goal_s", "time_to_goal", "s")):
+            vals = [float(e[col]) for e in ok]
+            if not vals:
+                assert row[f"{label}_mean_{unit}"] == ""
+                continue
+            m = statistics.fmean(vals)
+            assert float(row[f"{label}_mean_{unit}"]) == pytest.approx(m, rel=1e-12)
+            assert float(row[f"{label}_median_{unit}"]) == pytest.approx(
+                statistics.median(vals), rel=1e-12)
+            if len(vals) > 1:
+                lo, hi = sps.t.interval(0.95, len(vals) - 1, loc=m, scale=sps.sem(vals))
+                assert float(row[f"{label}_ci_low_{unit}"]) == pytest.approx(lo, rel=1e-9)
+                assert float(row[f"{label}_ci_high_{unit}"]) == pytest.approx(hi, rel=1e-9)
+        # episodes that did not reach the goal have no time to goal
+        assert all((e["time_to_goal_s"] == "") == (e["status"] != "REACHED") for e in mine)
+
+
+def test_report_and_figure(files, run):
+    md = files["report_md"].read_text(encoding="utf-8")
+    assert "episodes/s" in md and f"{len(run.records)} episodes" in md
+    for name in CFG.planners:
+        assert f"| {name} |" in md
+    for r in summary_rows(run):
+        assert f"| {r['moving']} | {r['planner']} | {r['reached']}/{r['episodes']} = " in md
+    im = Image.open(files["success_png"])
+    assert im.format == "PNG" and im.size[0] > 300
+
+
+def test_deterministic_and_independent_of_workers(run):
+    again = run_dynamic(CFG, workers=2)
+    assert again.workers == 2
+    strip = [{k: v for k, v in r.items() if k not in TIMING} for r in run.records]
+    assert strip == [{k: v for k, v in r.items() if k not in TIMING} for r in again.records]
+
+
+def test_parameters_reach_the_planner():
+    base = DynamicConfig(n_seeds=3, moving=(2,), planners=("fusion",), seed=4)
+    tuned = DynamicConfig(n_seeds=3, moving=(2,), planners=("fusion",), seed=4,
+                          params={"fusion": {"escape_ticks": 0, "swerve": 0.0}})
+    a, b = run_dynamic(base), run_dynamic(tuned)
+    scs = generate_scenarios(3, moving=2, speed_range=base.speed_range, seed=4)
+    for rec, sc in zip(b.records, scs, strict=True):
+        ep = simulate(sc, planner={"name": "fusion", "params": {"escape_ticks": 0,
+                                                                 "swerve": 0.0}})
+        assert (rec["status"], rec["path_length_m"]) == (ep.status.name, ep.path_length_m)
+    assert [r["path_length_m"] for r in a.records] != [r["path_length_m"] for r in b.records]
+
+
+def test_default_is_every_online_planner():
+    from pathfuse.world import online_planner_names
+
+    assert DynamicConfig().planners == tuple(online_planner_names())
+
+
+@pytest.mark.parametrize("kw,fragment", [
+    ({"n_seeds": 0}, "n_seeds"),
+    ({"seed": -1}, "seed"),
+    ({"moving": ()}, "moving"),
+    ({"moving": (2, -1)}, "moving"),
+    ({"moving": (1.5,)}, "moving"),
+    ({"speed_range": (0.0, 0.5)}, "speed_range"),
+    ({"speed_range": (0.9, 0.5)}, "speed_range"),
+    ({"speed_range": ("fast", 1)}, "speed_range"),
+    ({"speed_range": (0.5,)}, "speed_range"),
+    ({"planners": ("fusion", "nope")}, "planners: unknown online planner 'nope'"),
+    ({"planners": "fusion"}, "planners"),
+    ({"planners": ("fusion",), "params": {"apf": {}}}, "params.apf"),
+    ({"params": {"fusion": {"kat": 1}}}, "params.fusion.kat"),
+    ({"params": {"fusion": 3}}, "params.fusion"),
+])
+def test_bad_config_names_the_key(kw, fragment):
+    with pytest.raises(ConfigError, match=None) as exc:
+        DynamicConfig(**kw)
+    assert fragment in str(exc.value)
+
+
+def test_bad_workers():
+    with pytest.raises(ConfigError, match="workers"):
+        run_dynamic(DynamicConfig(n_seeds=1, moving=(0,), planners=("fusion",)), workers=0)

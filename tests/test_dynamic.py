@@ -184,3 +184,28 @@ def test_bad_config_names_the_key(kw, fragment):
 def test_bad_workers():
     with pytest.raises(ConfigError, match="workers"):
         run_dynamic(DynamicConfig(n_seeds=1, moving=(0,), planners=("fusion",)), workers=0)
+
+
+def test_paired_comparison_from_the_episode_csv(files):
+    eps = read_csv(files["episodes_csv"])
+    paired = read_csv(files["paired_csv"])
+    others = [p for p in CFG.planners if p != "fusion"]
+    assert [(int(r["moving"]), r["other"]) for r in paired] == \
+        [(k, o) for k in CFG.moving for o in others]
+    ok = {(e["moving"], e["index"], e["planner"]): e["status"] == "REACHED" for e in eps}
+    for r in paired:
+        pairs = [(ok[(r["moving"], str(i), "fusion")], ok[(r["moving"], str(i), r["other"])])
+                 for i in range(CFG.n_seeds)]
+        assert int(r["both"]) == sum(a and b for a, b in pairs)
+        assert int(r["only_reference"]) == sum(a and not b for a, b in pairs)
+        assert int(r["only_other"]) == sum(b and not a for a, b in pairs)
+        assert int(r["neither"]) == sum(not a and not b for a, b in pairs)
+        d = int(r["only_reference"]) + int(r["only_other"])
+        # exact two-sided McNemar: sum of binomial(d, 1/2) probabilities <= that observed
+        probs = [math.comb(d, j) / 2 ** d for j in range(d + 1)]
+        obs = probs[int(r["only_reference"])] if d else 1.0
+        p = sum(q for q in probs if q <= obs * (1 + 1e-7)) if d else 1.0
+        assert float(r["p_value"]) == pytest.approx(min(1.0, p), rel=1e-9)
+    # with 3 discs astar-follow lost scenarios the fusion reached
+    row = next(r for r in paired if r["moving"] == "3" and r["other"] == "astar-follow")
+    assert int(row["only_reference"]) > int(row["only_other"])

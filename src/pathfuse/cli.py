@@ -535,8 +535,10 @@ an animation plays in real time unless that takes more than 150 frames, then fas
         "scenarios per number of moving discs (paper map family, start (1, 1), goal (11, 11), "
         "discs aimed across the route; deterministic in --seed) and write, into --out: "
         "dynamic.md (success, collision, timeout and local-minimum rates with 95% Wilson "
-        "intervals, path length and time to goal over the successful episodes), summary.csv, "
-        "episodes.csv (one row per episode, nothing dropped) and success_vs_moving.png.",
+        "intervals, path length and time to goal over the successful episodes, a paired "
+        "comparison with the fusion), summary.csv, episodes.csv (one row per episode, nothing "
+        "dropped), paired.csv and success_vs_moving.png.  The defaults (1200 episodes) take "
+        "about 15 s on one core.",
         epilog=_fmt("""
 examples:
   pathfuse dynamic
@@ -546,8 +548,8 @@ examples:
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    dy.add_argument("--seeds", type=_positive_int, default=20,
-                    help="scenarios per number of moving discs (default 20)")
+    dy.add_argument("--seeds", type=_positive_int, default=50,
+                    help="scenarios per number of moving discs (default 50)")
     dy.add_argument("--moving", type=_nonneg_int, nargs="+", default=[0, 2, 4, 8],
                     metavar="K", help="numbers of moving discs (default: 0 2 4 8)")
     dy.add_argument("--speed", default="0.3,0.8", metavar="MIN,MAX",

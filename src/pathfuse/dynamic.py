@@ -51,6 +51,7 @@ __all__ = [
     "run_dynamic",
     "summary_rows",
     "success_pivot",
+    "paired_rows",
     "markdown_report",
     "write_dynamic_outputs",
 ]
@@ -96,7 +97,7 @@ class DynamicConfig:
     pathfuse.result.ConfigError: speed_range: expected (low, high) with 0 < low <= high ...
     """
 
-    n_seeds: int = 20
+    n_seeds: int = 50
     moving: tuple[int, ...] = (0, 2, 4, 8)
     speed_range: tuple[float, float] = (0.3, 0.8)
     planners: tuple[str, ...] = ()
@@ -352,6 +353,44 @@ def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
     return rows
 
 
+def paired_rows(run: DynamicRun, reference: str = "fusion") -> list[dict[str, Any]]:
+    """Paired success comparison of ``reference`` against every other planner.
+
+    Every planner runs the same scenarios, so per number of discs the
+    scenarios split into both reached / only ``reference`` reached / only the
+    other reached / neither.  ``p_value`` is the exact two-sided McNemar test
+    on the discordant pairs (binomial, p = 1/2): small when one planner wins
+    the scenarios they disagree on more often than chance would.  Empty when
+    ``reference`` was not run.
+
+    >>> cfg = DynamicConfig(n_seeds=2, moving=(1,), planners=("fusion", "astar-follow"))
+    >>> [sorted(r)[:4] for r in paired_rows(run_dynamic(cfg))]
+    [['both', 'moving', 'neither', 'only_other']]
+    """
+    from scipy.stats import binomtest
+
+    cfg = run.config
+    if reference not in cfg.planners:
+        return []
+    ok = {(r["moving"], r["index"], r["planner"]): r["status"] == "REACHED"
+          for r in run.records}
+    rows = []
+    for k in cfg.moving:
+        for name in cfg.planners:
+            if name == reference:
+                continue
+            c = {"both": 0, "only_reference": 0, "only_other": 0, "neither": 0}
+            for i in range(cfg.n_seeds):
+                a, b = ok[(k, i, reference)], ok[(k, i, name)]
+                c["both" if a and b else "only_reference" if a else "only_other" if b
+                  else "neither"] += 1
+            d = c["only_reference"] + c["only_other"]
+            p = 1.0 if d == 0 else float(binomtest(c["only_reference"], d, 0.5).pvalue)
+            rows.append({"moving": k, "reference": reference, "other": name, **c,
+                         "p_value": p})
+    return rows
+
+
 def success_pivot(rows: Sequence[Mapping[str, Any]], key: str = "reached") -> list[list[str]]:
     """A planner x moving table of ``key`` rates (``"reached"``, ``"collision"``, ...)."""
     moving: list[int] = []
@@ -430,6 +469,7 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
         f"{markdown_table(success_pivot(rows))}\n\n"
         "## Collision rate [95% Wilson CI]\n\n"
         f"{markdown_table(success_pivot(rows, 'collision'))}\n\n"
+        f"{_paired_md(run)}"
         "## All outcomes\n\n"
         f"{markdown_table(table)}\n\n"
         "Counts per row add up to the episodes run (nothing dropped); rates carry 95% Wilson "
@@ -438,6 +478,23 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
         "interval of the mean.  Plan time is the wall-clock time of the planner's per-tick "
         "decision, averaged over ticks and then over episodes.\n"
     )
+
+
+def _paired_md(run: DynamicRun) -> str:
+    rows = paired_rows(run)
+    if not rows:
+        return ""
+    table = [["discs", "fusion vs", "both reached", "only fusion", "only the other",
+              "neither", "McNemar p (exact)"]]
+    for r in rows:
+        table.append([str(r["moving"]), r["other"], str(r["both"]), str(r["only_reference"]),
+                      str(r["only_other"]), str(r["neither"]), f"{r['p_value']:.2g}"])
+    return (
+        "## Fusion against each planner, scenario by scenario\n\n"
+        "Every planner ran the same scenarios; \"only fusion\" counts the scenarios the fusion "
+        "reached and the other did not.  The p-value is the exact two-sided McNemar test on "
+        "those discordant scenarios (no correction for the many comparisons).\n\n"
+        f"{markdown_table(table)}\n\n")
 
 
 def _csv_value(v: Any) -> Any:
@@ -449,7 +506,8 @@ def _csv_value(v: Any) -> Any:
 
 
 def write_dynamic_outputs(run: DynamicRun, out_dir: str | Path) -> dict[str, Path]:
-    """Write ``dynamic.md``, ``summary.csv``, ``episodes.csv`` and ``success_vs_moving.png``.
+    """Write ``dynamic.md``, ``summary.csv``, ``episodes.csv``, ``paired.csv`` (when the
+    fusion was run: :func:`paired_rows`) and ``success_vs_moving.png``.
 
     Empty CSV cells are missing values (no successful episode, no time to goal).
     """
@@ -466,6 +524,10 @@ def write_dynamic_outputs(run: DynamicRun, out_dir: str | Path) -> dict[str, Pat
     write_csv(files["summary_csv"], [{k: _csv_value(v) for k, v in r.items()} for r in rows])
     write_csv(files["episodes_csv"],
               [{k: _csv_value(v) for k, v in r.items()} for r in run.records])
+    paired = paired_rows(run)
+    if paired:
+        files["paired_csv"] = out / "paired.csv"
+        write_csv(files["paired_csv"], paired)
     from pathfuse.viz.animate import plot_success_vs_moving
 
     cfg = run.config

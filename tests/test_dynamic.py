@@ -209,3 +209,21 @@ def test_paired_comparison_from_the_episode_csv(files):
     # with 3 discs astar-follow lost scenarios the fusion reached
     row = next(r for r in paired if r["moving"] == "3" and r["other"] == "astar-follow")
     assert int(row["only_reference"]) > int(row["only_other"])
+
+
+def test_success_plot_accepts_rates_at_0_and_1(tmp_path):
+    from pathfuse.stats import wilson_ci
+    from pathfuse.viz.animate import plot_success_vs_moving
+
+    rows = []
+    for k, n in ((0, 50), (50, 50), (0, 7), (7, 7), (3, 7)):
+        p, lo, hi = wilson_ci(k, n)
+        assert (k > 0 or lo == 0.0) and (k < n or hi == 1.0)
+        rows.append({"planner": f"p{k}-{n}", "moving": 2, "reached_rate": p,
+                     "reached_ci_low": lo, "reached_ci_high": hi})
+    # an interval end that rounding put a hair beyond the rate must not break the plot
+    rows.append({"planner": "eps", "moving": 2, "reached_rate": 0.0,
+                 "reached_ci_low": 1e-17, "reached_ci_high": 0.07})
+    out = tmp_path / "s.png"
+    plot_success_vs_moving(rows, out)
+    assert Image.open(out).format == "PNG"

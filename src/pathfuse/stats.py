@@ -50,6 +50,8 @@ def wilson_ci(successes: int, n: int, level: float = 0.95) -> tuple[float, float
 
     >>> [round(v, 4) for v in wilson_ci(95, 100)]
     [0.95, 0.8882, 0.9785]
+    >>> wilson_ci(0, 50)[:2], wilson_ci(50, 50)[::2]
+    ((0.0, 0.0), (1.0, 1.0))
     """
     if n == 0:
         return (math.nan, math.nan, math.nan)
@@ -60,7 +62,11 @@ def wilson_ci(successes: int, n: int, level: float = 0.95) -> tuple[float, float
     den = 1 + z * z / n
     centre = (p + z * z / (2 * n)) / den
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return (p, max(0.0, centre - half), min(1.0, centre + half))
+    # the interval reaches 0 (1) exactly when there are no successes (failures); rounding
+    # in centre -/+ half would leave a 1e-17 gap
+    low = 0.0 if successes == 0 else max(0.0, centre - half)
+    high = 1.0 if successes == n else min(1.0, centre + half)
+    return (p, low, high)
 
 
 def markdown_table(table: Sequence[Sequence[Any]]) -> str:

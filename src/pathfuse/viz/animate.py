@@ -568,7 +568,8 @@ def plot_success_vs_moving(
         lo = np.array([float(r["reached_ci_low"]) for r in rs])
         hi = np.array([float(r["reached_ci_high"]) for r in rs])
         colour = ONLINE_COLOURS.get(name, _FALLBACK_COLOURS[i % len(_FALLBACK_COLOURS)])
-        ax.errorbar(x, 100 * y, yerr=100 * np.vstack([y - lo, hi - y]), fmt="-o", ms=4,
+        yerr = np.clip(100 * np.vstack([y - lo, hi - y]), 0.0, None)  # no -1e-15 from rounding
+        ax.errorbar(x, 100 * y, yerr=yerr, fmt="-o", ms=4,
                     capsize=3, lw=1.5, color=colour, label=name)
     ax.set_xticks(moving)
     ax.set_xlabel("moving obstacles per scenario")

@@ -117,6 +117,7 @@ def _bad_scenario(tmp_path):
     (("simulate", HEAD_ON, "--seed", "-1"), ("--seed",)),
     (("simulate", HEAD_ON, "--fps", "0"), ("--fps",)),
     (("simulate", HEAD_ON, "--gif", "a.gif", "--mp4", "b.mp4"), ("--mp4",)),
+    (("simulate", HEAD_ON, "--gif", "no-such-dir/a.gif"), ("--gif", "no-such-dir", "exist")),
     (("dynamic", "--planners", "fusion,nope"), ("planners", "'nope'")),
     (("dynamic", "--planners", ","), ("--planners",)),
     (("dynamic", "--speed", "fast"), ("--speed", "'fast'")),

@@ -307,6 +307,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
         if fmt == "mp4":
             require_ffmpeg()  # before simulating: fail fast, in one line
+        parent = Path(out).expanduser().resolve().parent
+        if not parent.is_dir():
+            raise CliError(f"--{fmt}: the folder {parent} does not exist")
     sc = load_scenario(args.scenario)
     params = parse_params(args.param)
     if args.planner is None or args.planner == sc.planner.name:

@@ -315,4 +315,4 @@ def test_bad_params_name_the_value(bad):
 def test_defaults_documented_values():
     p = FusionParams()
     assert (p.k_att, p.k_rep, p.rho0_m) == (40.0, 5.0, 2.0)
-    assert p.r1_m == 1.5 and p.r2_m == p.rho0_m and p.ahead == "progress" and p.escape
+    assert p.r1_m == p.r2_m == p.rho0_m and p.ahead == "progress" and p.escape

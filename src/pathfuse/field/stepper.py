@@ -33,12 +33,14 @@ Building blocks (pure functions)
         one collision-free move along a force (see below).
 
 Batch loops
-    :func:`apf_run` and :func:`fusion_run` step until the goal, a stall, or
-    ``n_stop`` points are in the path buffer; they return so that the caller
-    can check a wall-clock limit between chunks and call them again to resume.
-    Their scalar settings travel in two small arrays built by
-    :func:`pack_apf` / :func:`pack_fusion` (few arguments = little dispatch
-    overhead).
+    :func:`apf_run` and :func:`fusion_run` step until the goal, a stall, a
+    step cap, or ``n_stop`` points in the path buffer; they return so that
+    the caller can check a wall-clock limit between chunks and call them again
+    to resume (:func:`pathfuse.field.driver.drive` does this).  Their scalar
+    settings travel in two small arrays built by :func:`pack_apf` /
+    :func:`pack_fusion` (few arguments = little dispatch overhead).
+    :func:`apf_solve` and :func:`fusion_solve` run a whole plan in one call
+    when there is no time limit.
 
 The safe step
     The robot moves ``step`` metres along the unit force.  If that straight
@@ -79,7 +81,7 @@ import math
 import numpy as np
 from numba import njit
 
-from pathfuse.field.forces import att_force_xy, rep_force_xy
+from pathfuse.field.forces import D_MIN_M, att_force_xy
 
 __all__ = [
     "MARGIN_FRAC",
@@ -104,8 +106,11 @@ __all__ = [
     "find_backoff",
     "apf_run",
     "fusion_run",
+    "apf_solve",
+    "fusion_solve",
     "pack_apf",
     "pack_fusion",
+    "polyline_cumlen",
 ]
 
 #: Clearance kept from occupied squares beyond the robot radius, in cells.
@@ -130,8 +135,8 @@ AHEAD_PAPER_X = 1
 
 # float config slots (pack_apf / pack_fusion)
 F_GX, F_GY, F_KATT, F_KREP, F_RHO0, F_RADIUS, F_STEP, F_TOL = 0, 1, 2, 3, 4, 5, 6, 7
-F_CLEAR, F_STALLD, F_OX, F_OY, F_RES, F_R1 = 8, 9, 10, 11, 12, 13
-N_F = 14
+F_CLEAR, F_STALLD, F_OX, F_OY, F_RES, F_R1, F_BACKOFF = 8, 9, 10, 11, 12, 13, 14
+N_F = 15
 # int config slots
 I_STALLN, I_AHEAD, I_ESCAPE, I_ESC_PTS = 0, 1, 2, 3
 N_I = 4
@@ -163,15 +168,27 @@ def grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m):
     fx = 0.0
     fy = 0.0
     rad2 = rad * rad
+    inv_rho0 = 1.0 / rho0_m
+    x0 = x - (ox + 0.5 * res)
     for r in range(r0, r1 + 1):
         dy = y - (oy + (r + 0.5) * res)
+        dy2 = dy * dy
         for c in range(c0, c1 + 1):
             if occ[r, c]:
-                dx = x - (ox + (c + 0.5) * res)
-                if dx * dx + dy * dy < rad2:
-                    ax, ay = rep_force_xy(dx, dy, k_rep, rho0_m)
-                    fx += ax
-                    fy += ay
+                dx = x0 - c * res
+                d2 = dx * dx + dy2
+                if d2 < rad2 and d2 > 0.0:
+                    # eq. 6, as rep_force_xy, without the cost of hypot
+                    d = math.sqrt(d2)
+                    if d > D_MIN_M:
+                        inv = 1.0 / d
+                        m = k_rep * (inv - inv_rho0) * inv * inv * inv
+                        fx += m * dx
+                        fy += m * dy
+                    else:
+                        mag = k_rep * (1.0 / D_MIN_M - inv_rho0) / (D_MIN_M * D_MIN_M)
+                        fx += mag * (dx / d)
+                        fy += mag * (dy / d)
     return fx, fy
 
 
@@ -216,7 +233,9 @@ def fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0_m, r1_m, r
                     fy -= k_att * dy
                     na += 1
     else:
-        reach = math.hypot(x - pts[k, 0], y - pts[k, 1]) + r1_m
+        ex = x - pts[k, 0]
+        ey = y - pts[k, 1]
+        reach = math.sqrt(ex * ex + ey * ey) + r1_m
         j = k + 1
         while j < m and cum[j] - cum[k] <= reach:
             dx = x - pts[j, 0]
@@ -247,7 +266,9 @@ def _point_segment(px, py, ax, ay, bx, by):
     if l2 > 0.0:
         t = ((px - ax) * vx + (py - ay) * vy) / l2
         t = min(max(t, 0.0), 1.0)
-    return math.hypot(px - (ax + t * vx), py - (ay + t * vy))
+    ex = px - (ax + t * vx)
+    ey = py - (ay + t * vy)
+    return math.sqrt(ex * ex + ey * ey)
 
 
 @njit(cache=True, inline="always")
@@ -316,6 +337,11 @@ def segment_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear):
         for c in range(c0, c1 + 1):
             if occ[r, c]:
                 x0 = ox + c * res
+                # cheap exact rejection: missing the box grown by ``clear`` as a square
+                # means the distance (to the box grown by a disc) is above ``clear``
+                if not _segment_hits_box(ax, ay, bx, by, x0 - clear, y0 - clear,
+                                         x0 + res + clear, y0 + res + clear):
+                    continue
                 if segment_box_distance(ax, ay, bx, by, x0, y0, x0 + res, y0 + res) < clear:
                     return False
     return True
@@ -329,7 +355,11 @@ def safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear):
     :data:`HOW_SLIDE`, :data:`HOW_SHORT` or :data:`HOW_BLOCKED` (no move; the
     position is returned unchanged).  A zero or non-finite force blocks.
     """
-    fn = math.hypot(fx, fy)
+    fn2 = fx * fx + fy * fy
+    if fn2 > 1e-300 and fn2 < 1e300:
+        fn = math.sqrt(fn2)
+    else:
+        fn = math.hypot(fx, fy)
     if not (fn > 0.0) or not math.isfinite(fn):
         return x, y, HOW_BLOCKED
     ux = fx / fn
@@ -364,6 +394,16 @@ def safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear):
 
 # --------------------------------------------------------------------- progress along a path
 @njit(cache=True)
+def polyline_cumlen(pts):
+    """Cumulative arc length of a polyline ``pts`` (M, 2): ``cum[0] = 0``, ``cum[-1]`` = length."""
+    m = pts.shape[0]
+    cum = np.zeros(m)
+    for j in range(1, m):
+        cum[j] = cum[j - 1] + math.hypot(pts[j, 0] - pts[j - 1, 0], pts[j, 1] - pts[j - 1, 1])
+    return cum
+
+
+@njit(cache=True)
 def advance_progress(x, y, pts, cum, k, r1_m, occ, ox, oy, res, clear):
     """Monotone progress index along a path: the nearest *visible* path point within reach.
 
@@ -375,52 +415,141 @@ def advance_progress(x, y, pts, cum, k, r1_m, occ, ox, oy, res, clear):
     """
     m = pts.shape[0]
     best = k
-    bd = math.hypot(x - pts[k, 0], y - pts[k, 1])
-    reach = bd + r1_m
+    ex = x - pts[k, 0]
+    ey = y - pts[k, 1]
+    bd2 = ex * ex + ey * ey
+    reach = math.sqrt(bd2) + r1_m
     j = k + 1
     while j < m and cum[j] - cum[k] <= reach:
-        d = math.hypot(x - pts[j, 0], y - pts[j, 1])
-        if d < bd and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy, res, clear):
-            bd = d
+        ex = x - pts[j, 0]
+        ey = y - pts[j, 1]
+        d2 = ex * ex + ey * ey
+        if d2 < bd2 and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy, res, clear):
+            bd2 = d2
             best = j
         j += 1
     return best
 
 
 @njit(cache=True)
-def find_backoff(buf, n, pts, cum, rvis_m, occ, ox, oy, res, clear):
-    """Where to rejoin the global path after a stall: a walked point and a path point.
-
-    Over the walked points ``buf[:n]`` and the path points ``pts`` within
-    ``rvis_m`` of them with a clear straight move between the two, picks the
-    pair ``(i, j)`` that minimises the length of "walk to ``buf[i]``, go
-    straight to ``pts[j]``, follow the path to its end".  Returns ``(i, j)``,
-    or ``(-1, -1)`` when no walked point sees a path point.
-    """
+def _backoff_scan(buf, i_hi, i_lo_limit, pts, cand, cum, rvis_m, window_m, occ, ox, oy, res,
+                  clear):
     m = pts.shape[0]
     r2 = rvis_m * rvis_m
-    walked = 0.0
+    total = cum[m - 1]
+    back = 0.0
     best = np.inf
     bi = -1
     bj = -1
-    for i in range(n):
+    for i in range(i_hi, i_lo_limit - 1, -1):
         x = buf[i, 0]
         y = buf[i, 1]
-        if i > 0:
-            walked += math.hypot(x - buf[i - 1, 0], y - buf[i - 1, 1])
-        if walked >= best:
-            break
-        for j in range(m):
+        if i < i_hi:
+            ex = x - buf[i + 1, 0]
+            ey = y - buf[i + 1, 1]
+            back += math.sqrt(ex * ex + ey * ey)
+            if back > window_m:
+                break
+        for q in range(cand.shape[0]):
+            j = cand[q]
             dx = pts[j, 0] - x
             dy = pts[j, 1] - y
             d2 = dx * dx + dy * dy
             if d2 < r2:
-                score = walked + math.sqrt(d2) + (cum[m - 1] - cum[j])
+                score = math.sqrt(d2) + (total - cum[j]) - back
                 if score < best and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy,
                                                      res, clear):
                     best = score
                     bi = i
                     bj = j
+    return bi, bj
+
+
+@njit(cache=True)
+def find_backoff(buf, n, pts, cum, rvis_m, window_m, occ, ox, oy, res, clear, kbuf):
+    """Where to rejoin the global path after a stall: a walked point and a path point.
+
+    Over the walked points ``buf[i]`` and the path points ``pts[j]`` closer
+    than ``rvis_m`` to them with a clear straight move between the two, picks
+    the pair that minimises the length of "walk to ``buf[i]``, go straight to
+    ``pts[j]``, follow the path to its end".
+
+    First only the walked points at most ``window_m`` of walk back from
+    ``buf[n-1]`` are searched, against the path points that can be within
+    ``rvis_m`` of them.  If none of them sees a path point, the whole walk is
+    searched, each walked point ``i`` against the path points from its
+    progress index ``kbuf[i]`` (:func:`advance_progress` at the time) on,
+    within ``|buf[i] - pts[kbuf[i]]| + rvis_m`` of arc length, so the cost
+    stays proportional to the walk.  The start (``kbuf[0] = 0``) always sees
+    the first path point when it lies in the same free cell.  Returns
+    ``(i, j)``, or ``(-1, -1)`` when no walked point sees a path point.
+    """
+    m = pts.shape[0]
+    x = buf[n - 1, 0]
+    y = buf[n - 1, 1]
+    lim = window_m + rvis_m
+    near = np.empty(m, dtype=np.int64)
+    nk = 0
+    for j in range(m):
+        dx = pts[j, 0] - x
+        dy = pts[j, 1] - y
+        if dx * dx + dy * dy <= lim * lim:
+            near[nk] = j
+            nk += 1
+    r2 = rvis_m * rvis_m
+    total = cum[m - 1]
+    best = np.inf
+    bi = -1
+    bj = -1
+    back = 0.0
+    for i in range(n - 1, -1, -1):
+        x = buf[i, 0]
+        y = buf[i, 1]
+        if i < n - 1:
+            ex = x - buf[i + 1, 0]
+            ey = y - buf[i + 1, 1]
+            back += math.sqrt(ex * ex + ey * ey)
+            if back > window_m:
+                break
+        for q in range(nk):
+            j = near[q]
+            dx = pts[j, 0] - x
+            dy = pts[j, 1] - y
+            d2 = dx * dx + dy * dy
+            if d2 < r2:
+                score = math.sqrt(d2) + (total - cum[j]) - back
+                if score < best and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy,
+                                                     res, clear):
+                    best = score
+                    bi = i
+                    bj = j
+    if bi >= 0:
+        return bi, bj
+    walked = 0.0
+    for i in range(n):
+        x = buf[i, 0]
+        y = buf[i, 1]
+        if i > 0:
+            ex = x - buf[i - 1, 0]
+            ey = y - buf[i - 1, 1]
+            walked += math.sqrt(ex * ex + ey * ey)
+        k = kbuf[i]
+        ex = x - pts[k, 0]
+        ey = y - pts[k, 1]
+        reach = math.sqrt(ex * ex + ey * ey) + rvis_m
+        j = k
+        while j < m and cum[j] - cum[k] <= reach:
+            dx = pts[j, 0] - x
+            dy = pts[j, 1] - y
+            d2 = dx * dx + dy * dy
+            if d2 < r2:
+                score = walked + math.sqrt(d2) + (total - cum[j])
+                if score < best and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy,
+                                                     res, clear):
+                    best = score
+                    bi = i
+                    bj = j
+            j += 1
     return bi, bj
 
 
@@ -439,11 +568,12 @@ def pack_apf(goal, k_att, k_rep, rho0_m, radius_m, step_m, tol_m, clear_m, stall
 
 
 def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, stall_steps,
-                stall_distance_m, ox, oy, res, ahead, escape, escape_points):
+                stall_distance_m, ox, oy, res, ahead, escape, escape_points, backoff_window_m):
     """Float and int config arrays for :func:`fusion_run` (``r2_m`` is the repulsion radius)."""
     f, i = pack_apf(goal, k_att, k_rep, rho0_m, r2_m, step_m, tol_m, clear_m, stall_steps,
                     stall_distance_m, ox, oy, res)
     f[F_R1] = r1_m
+    f[F_BACKOFF] = backoff_window_m
     i[I_AHEAD] = ahead
     i[I_ESCAPE] = 1 if escape else 0
     i[I_ESC_PTS] = escape_points
@@ -457,7 +587,9 @@ def _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear):
     Returns ``(n, code)``: :data:`CODE_RUNNING` (not reached), :data:`CODE_GOAL`
     (already exactly at the goal) or :data:`CODE_GOAL_SNAP` (goal appended).
     """
-    if math.hypot(x - gx, y - gy) <= tol:
+    ex = x - gx
+    ey = y - gy
+    if ex * ex + ey * ey <= tol * tol:
         if x == gx and y == gy:
             return n, CODE_GOAL
         if segment_is_clear(x, y, gx, gy, occ, ox, oy, res, clear):
@@ -515,22 +647,27 @@ def apf_run(buf, n, n_stop, max_steps, occ, fcfg, icfg):
         y = ny
         if n - 1 >= stall_n:
             p = n - 1 - stall_n
-            if math.hypot(x - buf[p, 0], y - buf[p, 1]) < stall_d:
+            ex = x - buf[p, 0]
+            ey = y - buf[p, 1]
+            if ex * ex + ey * ey < stall_d * stall_d:
                 return n, CODE_STALLED, steps
 
 
 @njit(cache=True)
-def fusion_run(buf, n, n_stop, max_steps, occ, pts, cum, state, fcfg, icfg):
+def fusion_run(buf, n, n_stop, max_steps, occ, pts, cum, state, fcfg, icfg, kbuf):
     """Algorithm 2 steps from ``buf[n-1]``; the protocol of :func:`apf_run` plus the A* path.
 
     ``pts`` (M, 2) are the global path points (ending at the goal), ``cum``
     (M,) their cumulative arc length, ``state`` an int64 array of :data:`N_S`
-    slots carried between calls (all zero at the start).
+    slots carried between calls (all zero at the start), ``kbuf`` an int64
+    array as long as ``buf`` that receives the progress index at each path
+    point (``kbuf[0] = 0``; used by :func:`find_backoff`).
 
     Escape (``escape`` set in ``icfg``): when the robot stalls or is blocked it
     backs off along its own walk to the point from which it rejoins the path
-    best (:func:`find_backoff` with ``rvis = r1 + res``; the rest of the walk
-    is dropped from the path), goes straight to the chosen path point, then
+    best (:func:`find_backoff` with ``rvis = r1 + res`` and the backoff window
+    of ``fcfg``; the rest of the walk is dropped from the path), goes straight
+    to the chosen path point, then
     follows the path points one by one until it has reached the point
     ``escape_points`` past its progress index at the stall; then Algorithm 2
     resumes.  Every move is still checked by :func:`segment_is_clear`.
@@ -542,6 +679,7 @@ def fusion_run(buf, n, n_stop, max_steps, occ, pts, cum, state, fcfg, icfg):
     rho0 = fcfg[F_RHO0]
     r2 = fcfg[F_RADIUS]
     r1 = fcfg[F_R1]
+    backoff_window = fcfg[F_BACKOFF]
     step = fcfg[F_STEP]
     tol = fcfg[F_TOL]
     clear = fcfg[F_CLEAR]
@@ -584,13 +722,16 @@ def fusion_run(buf, n, n_stop, max_steps, occ, pts, cum, state, fcfg, icfg):
             else:
                 buf[n, 0] = nx
                 buf[n, 1] = ny
+                kbuf[n] = k
                 n += 1
                 steps += 1
                 x = nx
                 y = ny
                 if n - 1 - ref >= stall_n:
                     p = n - 1 - stall_n
-                    stalled = math.hypot(x - buf[p, 0], y - buf[p, 1]) < stall_d
+                    ex = x - buf[p, 0]
+                    ey = y - buf[p, 1]
+                    stalled = ex * ex + ey * ey < stall_d * stall_d
         else:
             # escape: straight moves of at most one step towards pts[t]
             tx = pts[t, 0]
@@ -615,6 +756,7 @@ def fusion_run(buf, n, n_stop, max_steps, occ, pts, cum, state, fcfg, icfg):
             if segment_is_clear(x, y, nx, ny, occ, ox, oy, res, clear):
                 buf[n, 0] = nx
                 buf[n, 1] = ny
+                kbuf[n] = k
                 n += 1
                 steps += 1
                 x = nx
@@ -634,7 +776,8 @@ def fusion_run(buf, n, n_stop, max_steps, occ, pts, cum, state, fcfg, icfg):
             i = -1
             j = -1
             if escape == 1:
-                i, j = find_backoff(buf, n, pts, cum, r1 + res, occ, ox, oy, res, clear)
+                i, j = find_backoff(buf, n, pts, cum, r1 + res, backoff_window, occ, ox, oy, res,
+                                    clear, kbuf)
             if i < 0:
                 code = CODE_BLOCKED if blocked else CODE_STALLED
                 break
@@ -655,3 +798,77 @@ def fusion_run(buf, n, n_stop, max_steps, occ, pts, cum, state, fcfg, icfg):
     state[S_T] = t
     state[S_BACKOFF] = backoff
     return n, code, steps
+
+
+# --------------------------------------------------------------------- one-call solvers
+@njit(cache=True)
+def apf_solve(occ, sx, sy, gx, gy, fcfg_template, icfg, max_steps):
+    """:func:`apf_run` from ``(sx, sy)`` to the goal ``(gx, gy)`` in one call, no time limit.
+
+    Allocates and grows the path buffer itself.  Returns ``(path, code,
+    steps)`` with ``code`` as :func:`apf_run` (:data:`CODE_RUNNING` means the
+    ``max_steps`` cap was reached).
+    """
+    fcfg = fcfg_template.copy()
+    fcfg[F_GX] = gx
+    fcfg[F_GY] = gy
+    cap = min(max_steps, 1022) + 2
+    buf = np.empty((cap, 2))
+    buf[0, 0] = sx
+    buf[0, 1] = sy
+    n = 1
+    total = 0
+    while True:
+        n, code, steps = apf_run(buf, n, cap - 1, max_steps - total, occ, fcfg, icfg)
+        total += steps
+        if code != CODE_RUNNING or total >= max_steps:
+            break
+        nb = np.empty((2 * cap, 2))
+        nb[:n] = buf[:n]
+        buf = nb
+        cap *= 2
+    return buf[:n].copy(), code, total
+
+
+@njit(cache=True)
+def fusion_solve(occ, sx, sy, gx, gy, global_path, fcfg_template, icfg, max_steps):
+    """:func:`fusion_run` in one call, no time limit (the fast path of the fusion planner).
+
+    ``global_path`` (M, 2) is the A* path; the goal is appended when it does
+    not end there.  Returns ``(path, code, steps, state)``.
+    """
+    m = global_path.shape[0]
+    if m > 0 and global_path[m - 1, 0] == gx and global_path[m - 1, 1] == gy:
+        pts = np.ascontiguousarray(global_path)
+    else:
+        pts = np.empty((m + 1, 2))
+        pts[:m] = global_path
+        pts[m, 0] = gx
+        pts[m, 1] = gy
+    cum = polyline_cumlen(pts)
+    state = np.zeros(N_S, dtype=np.int64)
+    fcfg = fcfg_template.copy()
+    fcfg[F_GX] = gx
+    fcfg[F_GY] = gy
+    cap = min(max_steps, 1022) + 2
+    buf = np.empty((cap, 2))
+    kbuf = np.empty(cap, dtype=np.int64)
+    buf[0, 0] = sx
+    buf[0, 1] = sy
+    kbuf[0] = 0
+    n = 1
+    total = 0
+    while True:
+        n, code, steps = fusion_run(buf, n, cap - 1, max_steps - total, occ, pts, cum, state,
+                                    fcfg, icfg, kbuf)
+        total += steps
+        if code != CODE_RUNNING or total >= max_steps:
+            break
+        nb = np.empty((2 * cap, 2))
+        nb[:n] = buf[:n]
+        buf = nb
+        nk = np.empty(2 * cap, dtype=np.int64)
+        nk[:n] = kbuf[:n]
+        kbuf = nk
+        cap *= 2
+    return buf[:n].copy(), code, total, state

@@ -23,7 +23,8 @@ Endings (``PlanResult.status``):
     ``Budget.time_limit_s`` passed (checked every 8192 steps).
 
 On failure ``path`` is the partial path walked so far.  ``iterations`` is the
-number of force steps; ``info`` holds ``step_m``, ``goal_tolerance_m``,
+number of force steps; ``time_s`` covers setting up and stepping (building
+the result is left out, as for A*); ``info`` holds ``step_m``, ``goal_tolerance_m``,
 ``step_time_s`` (time inside the stepping loop) and ``steps_per_s``.
 
 Examples
@@ -53,10 +54,11 @@ from pathfuse.field.driver import (
     check_positive,
     drive,
     failure_message,
+    outcome,
     resolve_stepping,
 )
 from pathfuse.field.forces import K_ATT, K_REP, RHO0_M
-from pathfuse.field.stepper import apf_force, apf_run, pack_apf
+from pathfuse.field.stepper import apf_force, apf_run, apf_solve, pack_apf
 from pathfuse.grid import GridMap
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.result import Budget, PlanResult, Status, path_length
@@ -77,7 +79,8 @@ class APFParams:
     rho0_m : float
         Influence distance rho_0 of an obstacle point, metres (paper: 2).
     step_m : float or None
-        Length of one move, metres.  Default: 0.1 x the map resolution.
+        Length of one move, metres.  Default: 0.5 x the map resolution
+        (:data:`pathfuse.field.driver.STEP_FRAC`).
     goal_tolerance_m : float or None
         The goal counts as reached within this distance (then a straight move
         onto it ends the path).  Default: one step.
@@ -97,7 +100,7 @@ class APFParams:
     step_m: float | None = None
     goal_tolerance_m: float | None = None
     robot_radius_m: float = 0.0
-    stall_steps: int = 40
+    stall_steps: int = 20
     stall_distance_m: float | None = None
 
     def __post_init__(self) -> None:
@@ -147,14 +150,21 @@ def plan_apf(
     goal = np.asarray(goal, dtype=np.float64).reshape(2)
     st = resolve_stepping(grid, p.step_m, p.goal_tolerance_m, p.stall_distance_m,
                           p.robot_radius_m, budget.max_iterations)
-    deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
     ox, oy = grid.origin
     fcfg, icfg = pack_apf(goal, p.k_att, p.k_rep, p.rho0_m, p.rho0_m, st.step_m,
                           st.goal_tolerance_m, st.clear_m, p.stall_steps, st.stall_distance_m,
                           ox, oy, grid.resolution)
     occ = grid.occupied
-    out = drive(lambda buf, n, n_stop, k: apf_run(buf, n, n_stop, k, occ, fcfg, icfg),
-                start, st.max_steps, deadline)
+    if budget.time_limit_s is None:
+        t1 = time.perf_counter()
+        path, code, steps = apf_solve(occ, float(start[0]), float(start[1]), float(goal[0]),
+                                      float(goal[1]), fcfg, icfg, st.max_steps)
+        out = outcome(path, code, steps, st.max_steps, time.perf_counter() - t1)
+    else:
+        deadline = t0 + budget.time_limit_s
+        out = drive(lambda buf, n, n_stop, k: apf_run(buf, n, n_stop, k, occ, fcfg, icfg),
+                    start, st.max_steps, deadline)
+    time_s = time.perf_counter() - t0
     info = {
         "step_m": st.step_m,
         "goal_tolerance_m": st.goal_tolerance_m,
@@ -163,8 +173,8 @@ def plan_apf(
     }
     msg = (f"reached the goal in {out.steps} steps" if out.status is Status.SUCCESS
            else failure_message(out, goal, st, p.stall_steps))
-    return PlanResult(out.status, out.path, path_length(out.path), time.perf_counter() - t0,
-                      "apf", 0, out.steps, msg, info)
+    return PlanResult(out.status, out.path, path_length(out.path), time_s, "apf", 0, out.steps,
+                      msg, info)
 
 
 def warmup() -> None:

@@ -249,33 +249,38 @@ def den():
     return read_movingai(DATA / "den312d.map")
 
 
-def test_max_iterations_boundary(den):
+@pytest.mark.parametrize("heuristic", ["euclidean", "octile"])
+def test_max_iterations_boundary(den, heuristic):
     p = read_scen(DATA / "den312d.map.scen", den)[-1]
-    full = pathfuse.plan(den, p.start, p.goal)
+    full = pathfuse.plan(den, p.start, p.goal, heuristic=heuristic)
     assert full.status is Status.SUCCESS and full.expansions > 10
-    exact = pathfuse.plan(den, p.start, p.goal, budget=Budget(max_iterations=full.expansions))
+    exact = pathfuse.plan(den, p.start, p.goal, budget=Budget(max_iterations=full.expansions),
+                          heuristic=heuristic)
     assert exact.status is Status.SUCCESS and exact.length == full.length
-    short = pathfuse.plan(den, p.start, p.goal, budget=Budget(max_iterations=full.expansions - 1))
+    short = pathfuse.plan(den, p.start, p.goal, heuristic=heuristic,
+                          budget=Budget(max_iterations=full.expansions - 1))
     assert short.status is Status.MAX_ITERATIONS
     assert short.expansions == full.expansions - 1
     assert short.path.shape == (0, 2) and short.length == 0.0
     assert "max_iterations" in short.message
 
 
-def test_timeout_and_chunked_resume(den, monkeypatch):
+@pytest.mark.parametrize("heuristic", ["euclidean", "octile"])  # ring / radix open list
+def test_timeout_and_chunked_resume(den, monkeypatch, heuristic):
     probs = read_scen(DATA / "den312d.map.scen", den)
     p = probs[-1]
-    ref = pathfuse.plan(den, p.start, p.goal, budget=Budget())
+    ref = pathfuse.plan(den, p.start, p.goal, budget=Budget(), heuristic=heuristic)
     monkeypatch.setattr(astar_mod, "_CHUNK", 1)
-    r = pathfuse.plan(den, p.start, p.goal, budget=Budget(time_limit_s=1e-9))
+    r = pathfuse.plan(den, p.start, p.goal, budget=Budget(time_limit_s=1e-9), heuristic=heuristic)
     assert r.status is Status.TIMEOUT and r.expansions >= 1 and r.path.shape == (0, 2)
     assert "time_limit_s" in r.message
     # many tiny chunks (kernel stopped and resumed every 3 expansions) give the same search
     monkeypatch.setattr(astar_mod, "_CHUNK", 3)
     for q in probs[::29] + [p]:
-        a = pathfuse.plan(den, q.start, q.goal, budget=Budget(time_limit_s=60.0))
+        a = pathfuse.plan(den, q.start, q.goal, budget=Budget(time_limit_s=60.0),
+                          heuristic=heuristic)
         monkeypatch.setattr(astar_mod, "_CHUNK", 1 << 16)
-        b = pathfuse.plan(den, q.start, q.goal)
+        b = pathfuse.plan(den, q.start, q.goal, heuristic=heuristic)
         monkeypatch.setattr(astar_mod, "_CHUNK", 3)
         assert a.status is b.status is Status.SUCCESS
         assert np.array_equal(a.path, b.path) and a.expansions == b.expansions
@@ -338,18 +343,19 @@ def _free_pairs(occ, n, seed):
     return [(tuple(free[i]), tuple(free[j])) for i, j in rng.integers(0, len(free), (n, 2))]
 
 
-def test_buffer_reuse_generation_wraparound_and_heap_growth():
+@pytest.mark.parametrize("heuristic", ["euclidean", "octile"])  # ring / radix open list
+def test_buffer_reuse_generation_wraparound_and_heap_growth(heuristic):
     occ = np.random.default_rng(11).random((60, 70)) < 0.3
     pairs = _free_pairs(occ, 40, 12)
-    fresh = [AStarSearcher(occ).search(s, g) for s, g in pairs]
+    fresh = [AStarSearcher(occ).search(s, g, heuristic=heuristic) for s, g in pairs]
     reused = AStarSearcher(occ)
     reused._gen = astar_mod._STAMP_LIMIT - 6  # force the stamp reset inside this run
     tiny = AStarSearcher(occ)
-    for name in ("_qkey", "_qnode", "_qnext"):  # start with a 16-entry pool: it must grow
+    for name in ("_qkey", "_qnode", "_qnext", "_skey", "_snode"):  # 16 entries: must grow
         setattr(tiny, name, getattr(tiny, name)[:16].copy())
     for (s, g), ref in zip(pairs, fresh, strict=True):
         for searcher in (reused, tiny):
-            r = searcher.search(s, g)
+            r = searcher.search(s, g, heuristic=heuristic)
             assert r.status == ref.status
             assert r.cost == ref.cost or (math.isinf(r.cost) and math.isinf(ref.cost))
             assert np.array_equal(r.cells, ref.cells)
@@ -388,3 +394,20 @@ def test_warmup_idempotent():
     t = time.perf_counter()
     astar_mod.warmup()
     assert time.perf_counter() - t < 0.01
+
+
+def test_small_heap_orders_exactly():
+    # the binary heap that orders the current ring bucket (euclidean open list)
+    rng = np.random.default_rng(5)
+    keys = rng.integers(0, 50, 300).astype(np.uint64)  # many ties
+    skey = np.empty(300, dtype=np.uint64)
+    snode = np.empty(300, dtype=np.int32)
+    size = 0
+    for i, k in enumerate(keys):
+        size = astar_mod._spush(skey, snode, size, k, i)
+    out = []
+    while size:
+        node, size = astar_mod._spop(skey, snode, size)
+        out.append(node)
+    assert sorted(out) == list(range(300))
+    assert np.all(np.diff(keys[out].astype(np.int64)) >= 0)

@@ -39,6 +39,7 @@ register(PlannerSpec("xother", _never, _Params, "second test planner"))
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared" / "data" / "movingai"
+MOVINGAI = REPO / "tests" / "data" / "movingai"  # the repository's copies of small maps
 
 ROWS = '{rows: ["......", ".##...", "......", "...#.."]}'
 
@@ -148,11 +149,11 @@ def test_paper_map_gets_seed_per_run_and_default_query(tmp_path):
     assert fixed[0].map_spec == {"paper": {"seed": 7}}
 
 
-@pytest.mark.skipif(not (SHARED / "den312d.map").is_file(), reason="shared data missing")
+@pytest.mark.skipif(not (MOVINGAI / "den312d.map").is_file(), reason="test data missing")
 def test_scen_lines_selection_and_portable_keys(tmp_path):
     for f in ("den312d.map", "den312d.map.scen"):
         (tmp_path / "data").mkdir(exist_ok=True)
-        shutil.copy(SHARED / f, tmp_path / "data" / f)
+        shutil.copy(MOVINGAI / f, tmp_path / "data" / f)
     text = """
 seeds: [0]
 maps:
@@ -164,7 +165,7 @@ planners: [xsweep]
 """
     runs = load_experiment(write(tmp_path, text % "[2, 10, 5]")).expand()
     assert [r.query["line"] for r in runs] == [2, 10, 5]
-    lines = (SHARED / "den312d.map.scen").read_text().splitlines()
+    lines = (MOVINGAI / "den312d.map.scen").read_text().splitlines()
     cols = lines[9].split("\t")  # file line 10
     assert runs[1].query["optimal_length"] == pytest.approx(float(cols[8]))
     assert runs[1].query["start"] == [int(cols[4]) + 0.5, 81 - int(cols[5]) - 0.5]
@@ -184,7 +185,7 @@ planners: [xsweep]
     assert keys == [r.key for r in load_experiment(write(moved, text % "4")).expand()]
     # ... but editing the map file changes them
     (moved / "data" / "den312d.map").write_text(
-        (SHARED / "den312d.map").read_text().replace("@", ".", 1))
+        (MOVINGAI / "den312d.map").read_text().replace("@", ".", 1))
     assert not set(keys) & {r.key for r in load_experiment(moved / "exp.yaml").expand()}
 
 

@@ -28,7 +28,7 @@ from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.planners.registry import planner_names
 from pathfuse.result import ConfigError
 
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "movingai"
+MOVINGAI = Path(__file__).resolve().parent / "data" / "movingai"
 
 PLUGIN = '''
 """A test planner: 8-connected Dijkstra without corner cutting, in plain Python."""
@@ -441,15 +441,15 @@ planners: [tdij]
     assert s1.failed == 1 and s1.succeeded == 0
 
 
-@pytest.mark.skipif(not (SHARED / "den312d.map").is_file(), reason="shared data missing")
+@pytest.mark.skipif(not (MOVINGAI / "den312d.map").is_file(), reason="test data missing")
 def test_scen_optimal_lengths_are_the_reference(tmp_path):
     exp = make_study(tmp_path, f"""
 seeds: [0]
 reference: null
 maps:
   - name: den312d
-    map: {{movingai: {SHARED / 'den312d.map'}}}
-    scen: {SHARED / 'den312d.map.scen'}
+    map: {{movingai: {MOVINGAI / 'den312d.map'}}}
+    scen: {MOVINGAI / 'den312d.map.scen'}
     lines: {{every: 29}}
 planners: [tdij]
 """)
@@ -458,7 +458,7 @@ planners: [tdij]
     run_bench(exp, tmp_path / "s.db", workers=1, progress=False)
     rows = comparable_rows(tmp_path / "s.db")
     assert len(rows) == 10
-    scen = (SHARED / "den312d.map.scen").read_text().splitlines()
+    scen = (MOVINGAI / "den312d.map.scen").read_text().splitlines()
     for r in rows.values():
         opt = float(scen[r["scen_line"] - 1].split("\t")[8])
         assert r["reference_source"] == "scen" and r["reference_length"] == opt

@@ -67,9 +67,9 @@ def test_open_map_goes_straight():
     assert r.path[0].tolist() == [0.5, 2.5] and r.path[-1].tolist() == [18.5, 2.5]
     assert r.length == pytest.approx(18.0, abs=1e-9)
     np.testing.assert_allclose(r.path[:, 1], 2.5)
-    # default step = 0.5 x resolution; only the last move (onto the goal) may be shorter
-    np.testing.assert_allclose(np.diff(r.path[:-1, 0]), 0.5)
-    assert 0 < r.path[-1, 0] - r.path[-2, 0] <= 0.5
+    # default step = 0.1 x resolution; only the last move (onto the goal) may be shorter
+    np.testing.assert_allclose(np.diff(r.path[:-1, 0]), 0.1)
+    assert 0 < r.path[-1, 0] - r.path[-2, 0] <= 0.1 + 1e-12
 
 
 @pytest.mark.parametrize("seed", range(40))
@@ -127,7 +127,7 @@ def test_iteration_cap():
     r = plan(g, (0.5, 2.5), (38.5, 2.5), planner="apf", budget=Budget(max_iterations=7))
     assert r.status is Status.MAX_ITERATIONS
     assert r.iterations == 7 and len(r.path) == 8
-    assert r.path[-1, 0] == pytest.approx(0.5 + 7 * 0.5)
+    assert r.path[-1, 0] == pytest.approx(0.5 + 7 * 0.1)
 
 
 def test_time_limit():
@@ -208,6 +208,6 @@ def test_bad_params_name_the_value(bad):
 def test_info_and_timing():
     g = paper_map(3)
     r = plan_apf(g, np.array(PAPER_START), np.array(PAPER_GOAL))
-    assert r.info["step_m"] == pytest.approx(0.5) and r.info["goal_tolerance_m"] == 0.5
+    assert r.info["step_m"] == pytest.approx(0.1) and r.info["goal_tolerance_m"] == 0.1
     assert 0 < r.info["step_time_s"] <= r.time_s
     assert r.iterations >= 1 and r.length == pytest.approx(path_length(r.path))

@@ -414,11 +414,27 @@ def advance_progress(x, y, pts, cum, k, r1_m, occ, ox, oy, res, clear):
     through a wall to a later part of the path that passes close by.
     """
     m = pts.shape[0]
-    best = k
     ex = x - pts[k, 0]
     ey = y - pts[k, 1]
-    bd2 = ex * ex + ey * ey
-    reach = math.sqrt(bd2) + r1_m
+    dk2 = ex * ex + ey * ey
+    reach = math.sqrt(dk2) + r1_m
+    # the nearest candidate first: usually the only one that needs a sight check
+    best = k
+    bd2 = dk2
+    j = k + 1
+    while j < m and cum[j] - cum[k] <= reach:
+        ex = x - pts[j, 0]
+        ey = y - pts[j, 1]
+        d2 = ex * ex + ey * ey
+        if d2 < bd2:
+            bd2 = d2
+            best = j
+        j += 1
+    if best == k or segment_is_clear(x, y, pts[best, 0], pts[best, 1], occ, ox, oy, res, clear):
+        return best
+    # the nearest one is out of sight: the nearest visible one
+    best = k
+    bd2 = dk2
     j = k + 1
     while j < m and cum[j] - cum[k] <= reach:
         ex = x - pts[j, 0]
@@ -429,40 +445,6 @@ def advance_progress(x, y, pts, cum, k, r1_m, occ, ox, oy, res, clear):
             best = j
         j += 1
     return best
-
-
-@njit(cache=True)
-def _backoff_scan(buf, i_hi, i_lo_limit, pts, cand, cum, rvis_m, window_m, occ, ox, oy, res,
-                  clear):
-    m = pts.shape[0]
-    r2 = rvis_m * rvis_m
-    total = cum[m - 1]
-    back = 0.0
-    best = np.inf
-    bi = -1
-    bj = -1
-    for i in range(i_hi, i_lo_limit - 1, -1):
-        x = buf[i, 0]
-        y = buf[i, 1]
-        if i < i_hi:
-            ex = x - buf[i + 1, 0]
-            ey = y - buf[i + 1, 1]
-            back += math.sqrt(ex * ex + ey * ey)
-            if back > window_m:
-                break
-        for q in range(cand.shape[0]):
-            j = cand[q]
-            dx = pts[j, 0] - x
-            dy = pts[j, 1] - y
-            d2 = dx * dx + dy * dy
-            if d2 < r2:
-                score = math.sqrt(d2) + (total - cum[j]) - back
-                if score < best and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy,
-                                                     res, clear):
-                    best = score
-                    bi = i
-                    bj = j
-    return bi, bj
 
 
 @njit(cache=True)
@@ -850,7 +832,9 @@ def fusion_solve(occ, sx, sy, gx, gy, global_path, fcfg_template, icfg, max_step
     fcfg = fcfg_template.copy()
     fcfg[F_GX] = gx
     fcfg[F_GY] = gy
-    cap = min(max_steps, 1022) + 2
+    # room for about twice the global path's length in steps; grown when needed
+    est = int(2.0 * cum[cum.shape[0] - 1] / fcfg[F_STEP]) + 64
+    cap = min(max_steps, est, 1 << 20) + 2
     buf = np.empty((cap, 2))
     kbuf = np.empty(cap, dtype=np.int64)
     buf[0, 0] = sx

@@ -79,7 +79,7 @@ class APFParams:
     rho0_m : float
         Influence distance rho_0 of an obstacle point, metres (paper: 2).
     step_m : float or None
-        Length of one move, metres.  Default: 0.5 x the map resolution
+        Length of one move, metres.  Default: 0.1 x the map resolution
         (:data:`pathfuse.field.driver.STEP_FRAC`).
     goal_tolerance_m : float or None
         The goal counts as reached within this distance (then a straight move
@@ -100,7 +100,7 @@ class APFParams:
     step_m: float | None = None
     goal_tolerance_m: float | None = None
     robot_radius_m: float = 0.0
-    stall_steps: int = 20
+    stall_steps: int = 40
     stall_distance_m: float | None = None
 
     def __post_init__(self) -> None:
@@ -180,8 +180,10 @@ def plan_apf(
 def warmup() -> None:
     """Compile (or load from numba's cache) the APF kernels on a tiny map."""
     g = GridMap.from_rows(["....", ".#..", "...."])
-    plan_apf(g, np.array([0.5, 0.5]), np.array([3.5, 2.5]))
-    force_at(g, (0.5, 0.5), (3.5, 2.5))
+    s, e = np.array([0.5, 0.5]), np.array([3.5, 2.5])
+    plan_apf(g, s, e)  # the one-call solver
+    plan_apf(g, s, e, budget=Budget(time_limit_s=60.0))  # the chunked loop
+    force_at(g, s, e)
 
 
 register(

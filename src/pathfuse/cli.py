@@ -237,7 +237,8 @@ def cmd_scen(args: argparse.Namespace) -> int:
                 )
     n = n_ok + n_bad
     print(f"{Path(args.scen).name}: {n_ok}/{n} lines match the optimal length "
-          f"(rel. tol {args.tol:g}); A* time {total_t:.3f} s, {1e3 * total_t / max(n, 1):.3f} ms/query")
+          f"(rel. tol {args.tol:g}); A* time {total_t:.3f} s, "
+          f"{1e3 * total_t / max(n, 1):.3f} ms/query")
     for line in worst:
         print(line)
     return 0 if n_bad == 0 else EXIT_FAIL
@@ -268,6 +269,7 @@ def cmd_paper(args: argparse.Namespace) -> int:
     cfg = PaperConfig(
         n_seeds=args.seeds, first_seed=args.first_seed,
         figure_seed=args.seed if args.seed is not None else args.first_seed,
+        step_m=args.step,
     )
     if not cfg.first_seed <= cfg.figure_seed < cfg.first_seed + cfg.n_seeds:
         raise CliError(
@@ -286,13 +288,14 @@ def cmd_paper(args: argparse.Namespace) -> int:
     files = write_paper_outputs(run, args.out)
     n_runs = len(run.records)
     print(f"{n_runs} runs on {cfg.n_seeds} maps in {run.wall_s:.2f} s "
-          f"({n_runs / max(run.wall_s, 1e-9):.0f} runs/s, {cfg.n_seeds / max(run.wall_s, 1e-9):.1f} maps/s)")
+          f"({n_runs / max(run.wall_s, 1e-9):.0f} runs/s, "
+          f"{cfg.n_seeds / max(run.wall_s, 1e-9):.1f} maps/s)")
     print(f"{'planner':<8} {'success':>12} {'length mean':>12} {'R_length':>10} {'time mean':>11}")
     for r in summary_rows(run):
         rl = "-" if r["planner"] == "fusion" else f"{100 * r['r_length_mean']:+.2f}%"
         print(f"{r['planner']:<8} {r['successes']:>5}/{r['maps']:<6} "
               f"{r['length_mean_m']:>11.4f}m {rl:>10} {1e3 * r['time_mean_s']:>9.3f}ms")
-    for key, path in files.items():
+    for path in files.values():
         print(f"wrote {path}")
     return 0
 
@@ -486,6 +489,8 @@ examples:
     pp.add_argument("--first-seed", type=int, default=0, help="seed of the first map (default 0)")
     pp.add_argument("--seed", type=int, default=None,
                     help="the map of the one-map tables and Fig. 3 (default: the first seed)")
+    pp.add_argument("--step", type=_float, default=0.1,
+                    help="step length in metres of every stepping planner (default 0.1)")
     pp.add_argument("--out", default="paper-out", help="output folder (default paper-out)")
     pp.add_argument("--quiet", action="store_true", help="no progress bar")
     pp.set_defaults(func=cmd_paper)

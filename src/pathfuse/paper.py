@@ -76,6 +76,11 @@ class PaperConfig:
         Registry names; ``fusion`` must be among them for R_length / R_time.
     k_att, k_rep, rho0_m : float
         The paper's potential-field constants, given to every APF-based planner.
+    step_m : float
+        One step length (metres) for all four stepping planners (apf, ref6,
+        ref7, fusion), so that their lengths and times compare like for like.
+        The planners' own defaults differ (fusion steps 0.5 cells by default,
+        the others 0.1); 0.1 m is the finer, more faithful choice.
     params : dict
         Extra per-planner parameters, ``{name: {key: value}}``.
     """
@@ -87,6 +92,7 @@ class PaperConfig:
     k_att: float = 40.0
     k_rep: float = 5.0
     rho0_m: float = 2.0
+    step_m: float = 0.1
     params: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -98,7 +104,8 @@ class PaperConfig:
     def planner_params(self, name: str) -> dict[str, Any]:
         base: dict[str, Any] = {}
         if name in _APF_PLANNERS:
-            base = {"k_att": self.k_att, "k_rep": self.k_rep, "rho0_m": self.rho0_m}
+            base = {"k_att": self.k_att, "k_rep": self.k_rep, "rho0_m": self.rho0_m,
+                    "step_m": self.step_m}
         base.update(self.params.get(name, {}))
         return base
 
@@ -233,7 +240,9 @@ def _one_map_tables(run: PaperRun) -> tuple[str, list[list[str]]]:
 
     def cell_len(n: str) -> str:
         r = recs[n]
-        return f"{r['length_m']:.4f} (m)" if r["success"] else f"{r['status']} ({r['length_m']:.4f} m partial)"
+        if r["success"]:
+            return f"{r['length_m']:.4f} (m)"
+        return f"{r['status']} ({r['length_m']:.4f} m partial)"
 
     def r_of(n: str, key: str) -> str:
         if n == "fusion":
@@ -267,7 +276,8 @@ def _stats_tables(run: PaperRun, rows: list[dict[str, Any]]) -> str:
     def ci(r, a, lo, hi, scale=1.0, fmt="{:.4f}"):
         if not np.isfinite(r[a]):
             return "n/a"
-        return f"{fmt.format(r[a] * scale)} [{fmt.format(r[lo] * scale)}, {fmt.format(r[hi] * scale)}]"
+        lo_s, hi_s = fmt.format(r[lo] * scale), fmt.format(r[hi] * scale)
+        return f"{fmt.format(r[a] * scale)} [{lo_s}, {hi_s}]"
 
     def rr(r, label):
         if r["planner"] == "fusion":
@@ -291,7 +301,8 @@ def _stats_tables(run: PaperRun, rows: list[dict[str, Any]]) -> str:
         ["R_length median"] + [
             "-" if k == "fusion" else _pct(by[k]["r_length_median"]) for k in names],
         ["Maps where fusion is shorter"] + [
-            "-" if k == "fusion" else f"{by[k]['r_length_fusion_shorter']}/{by[k]['r_length_pairs']}"
+            "-" if k == "fusion"
+            else f"{by[k]['r_length_fusion_shorter']}/{by[k]['r_length_pairs']}"
             for k in names],
     ]
     t2 = [
@@ -305,8 +316,8 @@ def _stats_tables(run: PaperRun, rows: list[dict[str, Any]]) -> str:
             "-" if k == "fusion" else _pct(by[k]["r_time_median"]) for k in names],
     ]
     return (
-        f"### Table I over {n} maps (seeds {run.config.first_seed}..{run.config.first_seed + n - 1}):"
-        f" path length\n\n{_md(t1)}\n\n"
+        f"### Table I over {n} maps (seeds {run.config.first_seed}.."
+        f"{run.config.first_seed + n - 1}): path length\n\n{_md(t1)}\n\n"
         "Length statistics are over each planner's successful runs; R_length pairs only maps "
         "where both fusion and the reference succeeded (n = number of such maps). "
         "R < 0 means the fusion path is shorter (paper eq. 10).\n\n"
@@ -343,7 +354,8 @@ def write_paper_outputs(run: PaperRun, out_dir: str | Path) -> dict[str, Path]:
         "# Reproduction of Ju, Luo and Yan, Tables I and II\n\n"
         f"{run.config.n_seeds} paper-setup maps (15 m x 15 m, 1 m cells, start {PAPER_START}, "
         f"goal {PAPER_GOAL}, 50 random obstacle cells), K_att {run.config.k_att:g}, "
-        f"K_rep {run.config.k_rep:g}, rho_0 {run.config.rho0_m:g} m; "
+        f"K_rep {run.config.k_rep:g}, rho_0 {run.config.rho0_m:g} m, "
+        f"one step of {run.config.step_m:g} m for every stepping planner; "
         f"{len(run.records)} runs in {run.wall_s:.2f} s "
         f"({len(run.records) / max(run.wall_s, 1e-9):.0f} runs/s).\n\n"
         f"## The paper's values (one unpublished map)\n\n{paper_md}\n\n"

@@ -114,3 +114,13 @@ def test_planners_lists_the_registry():
     p = run("planners", "--json")
     assert p.returncode == 0
     assert sorted(json.loads(p.stdout)) == sorted(planner_names())
+
+
+def test_negative_coordinates_are_accepted_on_a_ros_map():
+    yaml_path = DATA / "ros" / "nav2_tb3_sandbox" / "tb3_sandbox.yaml"
+    p = run("plan", "--map", yaml_path, "--start", "-1.01,-0.51", "--goal", "1.5,0.5",
+            "--robot-radius", "0.1", "--json")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert d["status"] == "SUCCESS"
+    assert d["path"][0] == pytest.approx([-1.025, -0.525])  # centre of the start cell

@@ -586,9 +586,31 @@ examples:
     return parser
 
 
+_POINT_OPTIONS = ("--start", "--goal")
+
+
+def _join_negative_values(argv: Sequence[str]) -> list[str]:
+    """``--start -1,-0.5`` -> ``--start=-1,-0.5`` (argparse would take ``-1,...`` for an option)."""
+    out: list[str] = []
+    it = iter(argv)
+    for tok in it:
+        if tok in _POINT_OPTIONS:
+            nxt = next(it, None)
+            if nxt is not None and nxt[:1] == "-" and (nxt[1:2].isdigit() or nxt[1:2] == "."):
+                out.append(f"{tok}={nxt}")
+                continue
+            out.append(tok)
+            if nxt is not None:
+                out.append(nxt)
+            continue
+        out.append(tok)
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pathfuse`` console script."""
     parser = build_parser()
+    argv = _join_negative_values(sys.argv[1:] if argv is None else list(argv))
     args = parser.parse_args(argv)
     if not getattr(args, "command", None):
         parser.print_help()

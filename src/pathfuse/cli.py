@@ -38,6 +38,8 @@ examples:
   pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 500
   pathfuse simulate examples/scenarios/head_on.yaml --planner astar-follow --gif head_on.gif
   pathfuse dynamic --seeds 50 --moving 0 2 4 8 --out dynamic-out
+  pathfuse bench experiments/fusion-sweep-r1-r2-step.yaml --db sweep.db --seeds 20
+  pathfuse report sweep.db --out sweep-report
   pathfuse planners
 
 Run 'pathfuse COMMAND --help' for the options of a command.
@@ -403,6 +405,78 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
     return 0
 
 
+def parse_seeds(text: str) -> int | str | list[int]:
+    """``--seeds`` of ``pathfuse bench``: ``"20"`` (seeds 0..19), ``"100:200"`` or ``"3,7,9"``.
+
+    >>> parse_seeds("20"), parse_seeds("5:8"), parse_seeds("3, 7")
+    (20, '5:8', [3, 7])
+    """
+    t = str(text).strip()
+    try:
+        if ":" in t:
+            a, b = (int(x) for x in t.split(":"))
+            if not 0 <= a < b:
+                raise ValueError
+            return f"{a}:{b}"
+        if "," in t:
+            vals = [int(x) for x in t.split(",") if x.strip()]
+            if not vals or min(vals) < 0:
+                raise ValueError
+            return vals
+        n = int(t)
+        if n < 1:
+            raise ValueError
+        return n
+    except ValueError:
+        raise CliError(f"--seeds: expected a count N >= 1, a range A:B with 0 <= A < B, "
+                       f"or a list A,B,C of seeds >= 0, got {text!r}") from None
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from pathfuse.bench import SweepInterrupted, run_bench
+
+    seeds = None if args.seeds is None else parse_seeds(args.seeds)
+    try:
+        summary = run_bench(args.experiment, args.db, seeds=seeds, workers=args.workers,
+                            scheduler=args.scheduler,
+                            progress=False if args.no_progress else None,
+                            retry_errors=args.retry_errors, batch_size=args.batch_size)
+    except SweepInterrupted as exc:
+        print(exc.summary, flush=True)
+        print("pathfuse bench: interrupted; run the same command again to resume",
+              file=sys.stderr)
+        return 130
+    print(summary)
+    return 0 if summary.errors == 0 else EXIT_FAIL
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    from pathfuse.bench.report import build_report
+
+    report = build_report(args.db, reference=args.reference, params=args.param)
+    files = report.write(args.out, embed_images=not args.link_images)
+    study, rows = report.study, report.rows
+    pooled = {r["scope"] for r in rows if r["pooled"]}
+    shown = [r for r in rows if r["scope"] in pooled]
+    print(f"{args.db}: {len(study.runs)} runs, "
+          f"{len({r['experimentid'] for r in study.runs})} map entries, "
+          f"{len(study.config_ids())} planner configurations")
+    head = ("scope", "configuration", "runs", "success", "errors", "length mean", "R_length")
+    table = [head]
+    for r in shown:
+        rl = "n/a" if not r["r_length_pairs"] else \
+            f"{100 * r['r_length_mean']:+.2f}% (n={r['r_length_pairs']})"
+        lm = "n/a" if not r["length_n"] else f"{r['length_mean_m']:.3f} m"
+        table.append((r["scope"], r["config"], str(r["runs"]),
+                      f"{100 * r['success_rate']:.1f}%", str(r["errors"]), lm, rl))
+    widths = [max(len(row[i]) for row in table) for i in range(len(head))]
+    for row in table:
+        print("  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
+    print(f"wrote {len(files)} files into {args.out}: report.html, report.md, summary.csv, "
+          "parameters.csv and the figures")
+    return 0
+
+
 # --------------------------------------------------------------------------- parser
 def build_parser() -> argparse.ArgumentParser:
     from pathfuse import __version__
@@ -573,6 +647,82 @@ examples:
     dy.add_argument("--out", default="dynamic-out", help="output folder (default dynamic-out)")
     dy.add_argument("--quiet", action="store_true", help="no progress bar")
     dy.set_defaults(func=cmd_dynamic)
+
+    b = sub.add_parser(
+        "bench",
+        help="run (or resume) a benchmark sweep into a study database",
+        description="Run every run of an experiment file (maps x seeds x queries x planners "
+        "x parameter combinations) and store each in an SQLite study database in OMPL's "
+        "benchmark layout.  Runs already stored are skipped, so running the same command "
+        "again resumes an interrupted sweep.  Exit status 0 when no run raised, 1 when some "
+        "did (they are stored as ERROR with their traceback), 2 for a bad experiment file "
+        "or argument, 130 when interrupted (Ctrl-C; what finished is stored).",
+        epilog=_fmt("""
+examples:
+  pathfuse bench experiments/paper-static-1000-seeds.yaml --db paper.db
+  pathfuse bench experiments/fusion-sweep-r1-r2-step.yaml --db sweep.db --seeds 20
+  pathfuse bench experiments/fusion-sweep-r1-r2-step.yaml --db sweep.db --seeds 100:200
+  pathfuse bench experiments/dynamic-benchmark.yaml --db dyn.db --workers 1 --no-progress
+  pathfuse bench experiments/movingai-maps.yaml --db mai.db --scheduler tcp://10.0.0.5:8786
+  pathfuse report sweep.db --out sweep-report
+
+See experiments/*.yaml for the file format (maps, seeds, planners, swept parameters).
+"""),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    b.add_argument("experiment", help="experiment YAML file")
+    b.add_argument("--db", required=True, metavar="STUDY.db",
+                   help="SQLite study database (created if missing, resumed if not)")
+    b.add_argument("--seeds", metavar="N|A:B|A,B,..",
+                   help="override every seed list of the file: N (seeds 0..N-1), a range "
+                   "A:B or a list")
+    b.add_argument("--workers", type=_positive_int, default=None,
+                   help="local worker processes (default: every usable CPU; 1 = in this "
+                   "process)")
+    b.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                   help="run on a Dask distributed cluster (pip install 'pathfuse[dask]')")
+    b.add_argument("--batch-size", type=_positive_int, default=None,
+                   help="runs per task (default: about 8 tasks per worker, at most 64)")
+    b.add_argument("--retry-errors", action="store_true",
+                   help="run again the runs stored as ERROR")
+    b.add_argument("--no-progress", action="store_true",
+                   help="no progress bar (default: a bar on stderr when it is a terminal)")
+    b.set_defaults(func=cmd_bench)
+
+    r = sub.add_parser(
+        "report",
+        help="tables and figures of a study database (Markdown, CSV, PNG, HTML)",
+        description="Summarise a study database of 'pathfuse bench' per map entry and "
+        "planner configuration (and every entry pooled): runs, success rate with a 95%% "
+        "Wilson interval, errors (never dropped), collision-free rate, path length and "
+        "planning time (mean with a 95%% t interval, median), R_length against a reference "
+        "(paired on the same problem and seed, with the number of pairs), time to goal and "
+        "collisions for dynamic runs; box plots per configuration, and every swept "
+        "parameter against success rate and length.  Writes report.html (self-contained), "
+        "report.md, summary.csv, parameters.csv and PNG figures into --out.",
+        epilog=_fmt("""
+examples:
+  pathfuse report sweep.db --out sweep-report
+  pathfuse report paper.db --out paper-report --reference fusion
+  pathfuse report sweep.db --out r1 --param r1_m --param step_m
+  pathfuse report paper.db --out paper-report --reference 'fusion(r1_m=1)'
+
+--reference takes a planner configuration name as the tables show it, or a planner
+with one configuration; by default R_length is against the experiment's own reference
+(its 'reference:' planner, or the optimum of MovingAI scen lines).
+"""),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    r.add_argument("db", metavar="STUDY.db", help="study database written by pathfuse bench")
+    r.add_argument("--out", default="report-out", help="output folder (default report-out)")
+    r.add_argument("--reference", metavar="PLANNER_OR_CONFIG",
+                   help="R_length reference (default: the experiment's reference)")
+    r.add_argument("--param", action="append", metavar="NAME",
+                   help="parameter to plot against success rate and length, repeatable "
+                   "(default: every swept parameter)")
+    r.add_argument("--link-images", action="store_true",
+                   help="link the PNGs from report.html instead of embedding them")
+    r.set_defaults(func=cmd_report)
 
     q = sub.add_parser(
         "planners", help="list the registered planners and their default parameters",

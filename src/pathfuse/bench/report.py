@@ -1,0 +1,953 @@
+"""Reports of a study database: tables per planner configuration, box plots, sweeps.
+
+:func:`write_report` reads a study written by :func:`pathfuse.bench.run_bench`
+(``pathfuse bench``) and writes, into one folder:
+
+``report.md`` / ``report.html``
+    Every table and figure on one page (the HTML is self-contained: inline
+    CSS, the figures embedded as base64 and linked to their PNG files).
+``summary.csv``
+    One row per (scope, planner configuration); ``scope`` is a map entry
+    (OMPL experiment, e.g. ``"paper"``) or ``all`` / ``all static`` /
+    ``all dynamic`` (every entry of a run kind pooled).
+``parameters.csv``
+    For every swept parameter of a planner: one row per (scope, value),
+    pooling the configurations that share that value.
+``length_<entry>.png``, ``time_<entry>.png``, ``r_length_<entry>.png``
+    Box plots per planner configuration of each map entry.
+``param_<planner>_<name>.png``
+    A swept parameter against the success rate (95 % Wilson bars) and the
+    mean path length (95 % t bars).
+
+Statistics (every row):
+
+* ``runs`` counts every stored run; ``solved + not_solved + errors = runs``.
+  Runs that raised (``ERROR``) are counted separately and never dropped:
+  they count as not solved in the success rate.
+* success rate = solved / runs, with a 95 % Wilson score interval.
+* collision-free rate = solved runs whose path is collision-free / solved
+  runs whose path was checked (Wilson interval); collision rate = runs with
+  a collision / runs (dynamic worlds: the episode ended in a collision).
+* path length, time to goal: over solved runs (mean, 95 % Student-t
+  interval, median); planning time: over every run that did not raise.
+* R_length = (L - L_ref) / L_ref (the paper's eq.), over the runs where the
+  run *and* its reference solved the same problem (``problem_key`` + ``seed``);
+  ``r_length_pairs`` says how many.  By default the reference is the one the
+  experiment file named (the stored ``runs.R_length``: the reference
+  planner, or the optimum of a MovingAI scen line); ``reference=`` picks a
+  planner or planner configuration of the study instead.
+
+A swept parameter is one that takes more than one value among the
+configurations of a planner (per run kind), read from the configurations'
+full parameters (``plannerConfigs.settings``, the run's ``params`` without
+its seed).
+
+Examples
+--------
+>>> import pathlib, tempfile
+>>> from pathfuse.bench import run_bench
+>>> d = pathlib.Path(tempfile.mkdtemp())
+>>> _ = (d / "exp.yaml").write_text('''
+... seeds: 3
+... maps:
+...   - name: room
+...     map: {rows: ["......", ".##...", "......"]}
+...     start: [0.5, 0.5]
+...     goal: [5.5, 2.5]
+... planners:
+...   - name: astar
+...     params: {heuristic: [euclidean, octile]}
+... ''')
+>>> _ = run_bench(d / "exp.yaml", d / "study.db", workers=1, progress=False)
+>>> study = load_study(d / "study.db")
+>>> len(study.runs), swept_parameters(study)
+(6, {('static', 'astar'): ['heuristic']})
+>>> rows = summary_rows(study)
+>>> [(r["scope"], r["config"], r["runs"], r["solved"], r["r_length_mean"]) for r in rows]
+... # doctest: +NORMALIZE_WHITESPACE
+[('room', 'astar(heuristic=euclidean)', 3, 3, 0.0),
+ ('room', 'astar(heuristic=octile)', 3, 3, 0.0),
+ ('all', 'astar(heuristic=euclidean)', 3, 3, 0.0),
+ ('all', 'astar(heuristic=octile)', 3, 3, 0.0)]
+>>> files = write_report(d / "study.db", d / "out")
+>>> sorted(p.name for p in files.values())[:4]
+['length_room.png', 'param_astar_heuristic.png', 'parameters.csv', 'r_length_room.png']
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import math
+import re
+import sqlite3
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pathfuse.result import ConfigError
+from pathfuse.stats import markdown_table, mean_ci, wilson_ci, write_csv
+
+__all__ = [
+    "ConfigInfo",
+    "ExperimentInfo",
+    "Study",
+    "load_study",
+    "swept_parameters",
+    "resolve_reference",
+    "r_length_values",
+    "summary_rows",
+    "parameter_rows",
+    "write_report",
+    "build_report",
+    "StudyReport",
+]
+
+_RUN_FIELDS = ("id", "experimentid", "plannerid", "kind", "planner", "seed", "problem_key",
+               "solved", "status_name", "solution_length", "time", "collision_free",
+               "collisions", "time_to_goal", "R_length", "reference_source", "params")
+
+
+@dataclass(frozen=True)
+class ConfigInfo:
+    """One planner configuration (``plannerConfigs`` row) as the report names it.
+
+    ``name`` is the stored name, made unique within a run kind by appending
+    ``#id`` when two configurations share it; ``params`` are its full
+    parameters.
+    """
+
+    id: int
+    name: str
+    planner: str
+    kind: str
+    params: Mapping[str, Any]
+
+
+@dataclass(frozen=True)
+class ExperimentInfo:
+    """One map entry (OMPL experiment) of the study: ``name`` is ``"study/entry"``."""
+
+    id: int
+    name: str
+    entry: str
+    kind: str
+
+
+@dataclass
+class Study:
+    """The runs of a study database, read once.
+
+    ``runs`` are dicts of the columns in ``_RUN_FIELDS`` (``solved`` and
+    ``collision_free`` as bool or None), in ``runs.id`` order.
+    """
+
+    path: Path
+    runs: list[dict[str, Any]]
+    configs: dict[int, ConfigInfo]
+    experiments: dict[int, ExperimentInfo]
+    sessions: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def kinds(self) -> list[str]:
+        """Run kinds present, in order of first appearance."""
+        return list(dict.fromkeys(r["kind"] for r in self.runs))
+
+    def config_ids(self, kind: str | None = None) -> list[int]:
+        """Configuration ids that have runs (of ``kind``), in id order."""
+        ids = {r["plannerid"] for r in self.runs if kind is None or r["kind"] == kind}
+        return sorted(ids)
+
+
+# --------------------------------------------------------------------------- loading
+def _connect(path: Path) -> sqlite3.Connection:
+    if not path.exists():
+        raise ConfigError(f"{path}: no such study database")
+    if path.is_dir():
+        raise ConfigError(f"{path}: is a folder, not a study database")
+    with open(path, "rb") as fh:
+        head = fh.read(16)
+    if head and head != b"SQLite format 3\x00":
+        raise ConfigError(f"{path}: not an SQLite database (write one with pathfuse bench)")
+    try:
+        conn = sqlite3.connect(path.resolve().as_uri() + "?mode=ro", uri=True, timeout=60.0)
+        conn.row_factory = sqlite3.Row
+        tables = {r[0] for r in conn.execute(
+            "SELECT name FROM sqlite_master WHERE type IN ('table', 'view')")}
+    except sqlite3.Error as exc:
+        raise ConfigError(f"{path}: cannot read the database ({exc})") from None
+    need = {"runs", "experiments", "plannerConfigs", "pathfuse_meta"}
+    if not need <= tables:
+        conn.close()
+        missing = ", ".join(sorted(need - tables))
+        raise ConfigError(f"{path}: not a pathfuse study database (no table {missing}; "
+                          "write one with pathfuse bench)")
+    cols = {r[1] for r in conn.execute("PRAGMA table_info(runs)")}
+    lacking = [c for c in _RUN_FIELDS if c not in cols]
+    if lacking:
+        conn.close()
+        raise ConfigError(f"{path}: not a pathfuse study database (runs has no column "
+                          f"{', '.join(lacking)})")
+    return conn
+
+
+def _json(text: Any) -> Any:
+    try:
+        return json.loads(text) if isinstance(text, str) else None
+    except ValueError:
+        return None
+
+
+def _opt_bool(v: Any) -> bool | None:
+    return None if v is None else bool(v)
+
+
+def load_study(db_path: str | Path) -> Study:
+    """Read a study database (read-only).
+
+    Raises
+    ------
+    ConfigError
+        One line naming the file: missing, a folder, not SQLite, not written
+        by pathfuse, unreadable, or without any run.
+    """
+    path = Path(db_path)
+    conn = _connect(path)
+    try:
+        cols = ", ".join(f'runs."{c}"' for c in _RUN_FIELDS)
+        rows = conn.execute(f"SELECT {cols} FROM runs ORDER BY runs.id").fetchall()
+        exps = conn.execute("SELECT id, name, entry, kind FROM experiments ORDER BY id") \
+            .fetchall()
+        cfgs = conn.execute("SELECT id, name, planner, settings FROM plannerConfigs "
+                            "ORDER BY id").fetchall()
+        try:
+            sessions = [dict(r) for r in conn.execute(
+                "SELECT study, experiment_file, started_at, finished_at, state, host, "
+                "pathfuse_version, workers, scheduler, planned, skipped, ran, errors "
+                "FROM pathfuse_sessions ORDER BY id")]
+        except sqlite3.Error:
+            sessions = []
+    except sqlite3.Error as exc:
+        raise ConfigError(f"{path}: cannot read the database ({exc})") from None
+    finally:
+        conn.close()
+    if not rows:
+        raise ConfigError(f"{path}: the study holds no runs yet "
+                          "(run 'pathfuse bench EXPERIMENT.yaml --db "
+                          f"{path}' first)")
+    runs = []
+    for r in rows:
+        d = dict(r)
+        d["solved"] = bool(d["solved"])
+        d["collision_free"] = _opt_bool(d["collision_free"])
+        d["kind"] = d["kind"] or "static"
+        runs.append(d)
+    experiments = {}
+    for e in exps:
+        name = e["name"] or f"experiment {e['id']}"
+        entry = e["entry"] or name.rsplit("/", 1)[-1]
+        experiments[int(e["id"])] = ExperimentInfo(int(e["id"]), name, entry,
+                                                   e["kind"] or "static")
+    kind_of: dict[int, str] = {}
+    first_params: dict[int, Any] = {}
+    for d in runs:
+        kind_of.setdefault(d["plannerid"], d["kind"])
+        first_params.setdefault(d["plannerid"], d["params"])
+    configs: dict[int, ConfigInfo] = {}
+    for c in cfgs:
+        cid = int(c["id"])
+        if cid not in kind_of:
+            continue
+        params = _json(c["settings"])
+        if not isinstance(params, dict):  # fall back to the run's parameters (minus seed)
+            p = _json(first_params[cid])
+            params = dict(p.get("params") or {}) if isinstance(p, dict) else {}
+            params.pop("seed", None)
+        configs[cid] = ConfigInfo(cid, c["name"], c["planner"] or c["name"], kind_of[cid],
+                                  params)
+    # names unique within a kind
+    for kind in set(kind_of.values()):
+        same: dict[str, list[int]] = {}
+        for cid, c in configs.items():
+            if c.kind == kind:
+                same.setdefault(c.name, []).append(cid)
+        for name, ids in same.items():
+            if len(ids) > 1:
+                for cid in ids:
+                    c = configs[cid]
+                    configs[cid] = ConfigInfo(cid, f"{name}#{cid}", c.planner, c.kind, c.params)
+    for d in runs:
+        if d["plannerid"] not in configs:  # a run without its config row: keep it anyway
+            configs[d["plannerid"]] = ConfigInfo(d["plannerid"], f"config#{d['plannerid']}",
+                                                 d["planner"] or "?", d["kind"], {})
+        if d["experimentid"] not in experiments:
+            experiments[d["experimentid"]] = ExperimentInfo(
+                d["experimentid"], f"experiment {d['experimentid']}",
+                f"experiment-{d['experimentid']}", d["kind"])
+    return Study(path, runs, configs, experiments, sessions)
+
+
+# --------------------------------------------------------------------------- parameters
+def _value_key(v: Any) -> str:
+    return json.dumps(v, sort_keys=True)
+
+
+def swept_parameters(study: Study, names: Sequence[str] | None = None
+                     ) -> dict[tuple[str, str], list[str]]:
+    """``{(kind, planner): [parameter, ...]}`` of the parameters to plot.
+
+    Without ``names``: every parameter that takes more than one value among
+    the configurations of a planner (of one run kind).  With ``names``: those
+    parameters, for every planner that has them (:class:`ConfigError` naming
+    the parameters the study has when one is unknown).
+    """
+    by: dict[tuple[str, str], list[ConfigInfo]] = {}
+    for cid in study.config_ids():
+        c = study.configs[cid]
+        by.setdefault((c.kind, c.planner), []).append(c)
+    out: dict[tuple[str, str], list[str]] = {}
+    if names:
+        known = sorted({k for cs in by.values() for c in cs for k in c.params})
+        for n in names:
+            if n not in known:
+                raise ConfigError(f"--param {n}: no planner of the study has this parameter "
+                                  f"(parameters: {', '.join(known) or 'none'})")
+        for key, cs in by.items():
+            have = [n for n in dict.fromkeys(names) if any(n in c.params for c in cs)]
+            if have:
+                out[key] = have
+        return out
+    for key, cs in by.items():
+        keys = list(dict.fromkeys(k for c in cs for k in c.params))
+        sw = [k for k in keys
+              if len({_value_key(c.params.get(k)) for c in cs}) > 1]
+        if sw:
+            out[key] = sw
+    return out
+
+
+# --------------------------------------------------------------------------- R_length
+def resolve_reference(study: Study, name: str) -> dict[str, int]:
+    """``{kind: config id}`` of the reference ``name`` (a config name, or a planner that
+    has exactly one configuration in that run kind).  :class:`ConfigError` if none or
+    ambiguous."""
+    out: dict[str, int] = {}
+    for kind in study.kinds:
+        ids = study.config_ids(kind)
+        exact = [i for i in ids if study.configs[i].name == name]
+        if not exact:
+            exact = [i for i in ids if study.configs[i].planner == name]
+            if len(exact) > 1:
+                names = ", ".join(study.configs[i].name for i in exact)
+                raise ConfigError(f"--reference {name}: planner {name} has {len(exact)} "
+                                  f"configurations ({names}); name one of them")
+        if len(exact) == 1:
+            out[kind] = exact[0]
+    if not out:
+        avail = ", ".join(dict.fromkeys(study.configs[i].name for i in study.config_ids()))
+        raise ConfigError(f"--reference {name}: no such planner or configuration in "
+                          f"{study.path} (configurations: {avail})")
+    return out
+
+
+def r_length_values(study: Study, reference: str | None = None) -> dict[int, float]:
+    """``{run id: R_length}`` for every run paired with a solved reference.
+
+    ``reference=None``: the stored ``runs.R_length`` (the experiment's own
+    reference) of solved runs.  Otherwise each solved run of a kind is paired
+    with the reference configuration's solved run on the same ``problem_key``
+    and ``seed``: R = (L - L_ref) / L_ref.
+    """
+    out: dict[int, float] = {}
+    if reference is None:
+        for r in study.runs:
+            v = r["R_length"]
+            if r["solved"] and v is not None and math.isfinite(v):
+                out[r["id"]] = float(v)
+        return out
+    ref_ids = resolve_reference(study, reference)
+    ref_len: dict[tuple[str, str, int], float] = {}
+    for r in study.runs:
+        if ref_ids.get(r["kind"]) == r["plannerid"] and r["solved"] \
+                and r["solution_length"] is not None and r["solution_length"] > 0:
+            ref_len[(r["kind"], r["problem_key"], r["seed"])] = float(r["solution_length"])
+    for r in study.runs:
+        if not r["solved"] or r["solution_length"] is None:
+            continue
+        lr = ref_len.get((r["kind"], r["problem_key"], r["seed"]))
+        if lr is not None:
+            out[r["id"]] = (float(r["solution_length"]) - lr) / lr
+    return out
+
+
+def _reference_label(study: Study, reference: str | None) -> str:
+    if reference is not None:
+        ids = resolve_reference(study, reference)
+        return ", ".join(f"{study.configs[i].name} ({k})" for k, i in ids.items())
+    srcs = sorted({r["reference_source"] for r in study.runs if r["reference_source"]})
+    if not srcs:
+        return "none"
+    return ", ".join("the scen file's optimum" if s == "scen" else s for s in srcs) + \
+        " (the experiment's reference)"
+
+
+# --------------------------------------------------------------------------- statistics
+def _median(v: Sequence[float]) -> float:
+    return float(np.median(v)) if len(v) else math.nan
+
+
+def _group_stats(runs: Sequence[Mapping[str, Any]], rl: Mapping[int, float]) -> dict[str, Any]:
+    n = len(runs)
+    solved = [r for r in runs if r["solved"]]
+    errors = sum(r["status_name"] == "ERROR" for r in runs)
+    statuses: dict[str, int] = {}
+    for r in runs:
+        if not r["solved"]:
+            s = r["status_name"] or "UNKNOWN"
+            statuses[s] = statuses.get(s, 0) + 1
+    sr = wilson_ci(len(solved), n)
+    checked = [r for r in solved if r["collision_free"] is not None]
+    cf = sum(bool(r["collision_free"]) for r in checked)
+    cfr = wilson_ci(cf, len(checked))
+    coll = sum(1 for r in runs if (r["collisions"] or 0) > 0)
+    cr = wilson_ci(coll, n)
+    lengths = [float(r["solution_length"]) for r in solved if r["solution_length"] is not None]
+    times = [float(r["time"]) for r in runs
+             if r["status_name"] != "ERROR" and r["time"] is not None]
+    ttg = [float(r["time_to_goal"]) for r in solved if r["time_to_goal"] is not None]
+    rv = [rl[r["id"]] for r in runs if r["id"] in rl]
+    lm, tm, gm, rm = mean_ci(lengths), mean_ci(times), mean_ci(ttg), mean_ci(rv)
+    return {
+        "runs": n, "solved": len(solved), "not_solved": n - len(solved) - errors,
+        "errors": errors,
+        "failures": "; ".join(f"{k}:{v}" for k, v in sorted(statuses.items())),
+        "success_rate": sr[0], "success_ci_low": sr[1], "success_ci_high": sr[2],
+        "collision_checked": len(checked), "collision_free": cf,
+        "collision_free_rate": cfr[0], "collision_free_ci_low": cfr[1],
+        "collision_free_ci_high": cfr[2],
+        "collision_runs": coll, "collision_rate": cr[0], "collision_ci_low": cr[1],
+        "collision_ci_high": cr[2],
+        "length_n": len(lengths), "length_mean_m": lm[0], "length_ci_low_m": lm[1],
+        "length_ci_high_m": lm[2], "length_median_m": _median(lengths),
+        "time_n": len(times), "time_mean_s": tm[0], "time_ci_low_s": tm[1],
+        "time_ci_high_s": tm[2], "time_median_s": _median(times),
+        "time_to_goal_n": len(ttg), "time_to_goal_mean_s": gm[0],
+        "time_to_goal_ci_low_s": gm[1], "time_to_goal_ci_high_s": gm[2],
+        "time_to_goal_median_s": _median(ttg),
+        "r_length_pairs": len(rv), "r_length_mean": rm[0], "r_length_ci_low": rm[1],
+        "r_length_ci_high": rm[2], "r_length_median": _median(rv),
+        "r_length_shorter": sum(v < 0 for v in rv),
+    }
+
+
+def _scopes(study: Study) -> list[tuple[str, str, list[dict[str, Any]], bool]]:
+    """(scope, kind, runs, pooled): each map entry, then each kind pooled."""
+    out = []
+    names = _scope_names(study)
+    for eid in sorted(names):
+        rs = [r for r in study.runs if r["experimentid"] == eid]
+        out.append((names[eid], rs[0]["kind"], rs, False))
+    kinds = study.kinds
+    for kind in kinds:
+        rs = [r for r in study.runs if r["kind"] == kind]
+        out.append(("all" if len(kinds) == 1 else f"all {kind}", kind, rs, True))
+    return out
+
+
+def _scope_names(study: Study) -> dict[int, str]:
+    """Experiment id -> scope name (the entry, or the full name where entries repeat)."""
+    ids = sorted({r["experimentid"] for r in study.runs})
+    entries = [study.experiments[i].entry for i in ids]
+    return {i: (study.experiments[i].entry if entries.count(study.experiments[i].entry) == 1
+                else study.experiments[i].name) for i in ids}
+
+
+def summary_rows(study: Study, reference: str | None = None,
+                 rl: Mapping[int, float] | None = None) -> list[dict[str, Any]]:
+    """One row per (scope, planner configuration): see the module docstring.
+
+    ``scope`` is a map entry (``pooled`` False), then ``all`` (or ``all static`` / ``all
+    dynamic`` when the study has both kinds) pooling every entry of the kind.
+    ``param.<name>`` columns hold the configuration's value of every swept
+    parameter (empty where the planner has no such parameter).
+    """
+    if rl is None:
+        rl = r_length_values(study, reference)
+    swept = sorted({p for ps in swept_parameters(study).values() for p in ps})
+    rows = []
+    for scope, kind, runs, pooled in _scopes(study):
+        by: dict[int, list[dict[str, Any]]] = {}
+        for r in runs:
+            by.setdefault(r["plannerid"], []).append(r)
+        for cid in sorted(by):
+            c = study.configs[cid]
+            row: dict[str, Any] = {"scope": scope, "pooled": pooled, "kind": kind,
+                                   "planner": c.planner, "config": c.name}
+            for p in swept:
+                row[f"param.{p}"] = _param_text(c.params[p]) if p in c.params else ""
+            row.update(_group_stats(by[cid], rl))
+            rows.append(row)
+    return rows
+
+
+def _param_text(v: Any) -> str:
+    if isinstance(v, float):
+        return f"{v:g}"
+    if isinstance(v, str):
+        return v
+    return json.dumps(v)
+
+
+def _sort_values(values: Iterable[Any]) -> tuple[list[Any], bool]:
+    """Distinct values sorted; True when all are numbers (a numeric axis)."""
+    uniq = list({_value_key(v): v for v in values}.values())
+    numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in uniq)
+    if numeric:
+        return sorted(uniq), True
+    return sorted(uniq, key=_value_key), False
+
+
+def parameter_rows(study: Study, swept: Mapping[tuple[str, str], Sequence[str]] | None = None,
+                   reference: str | None = None, rl: Mapping[int, float] | None = None
+                   ) -> list[dict[str, Any]]:
+    """For each (kind, planner, parameter) of ``swept`` (default: auto-detected), one row
+    per (scope, value) pooling every configuration of the planner with that value."""
+    if swept is None:
+        swept = swept_parameters(study)
+    if rl is None:
+        rl = r_length_values(study, reference)
+    rows = []
+    for (kind, planner), params in swept.items():
+        cfg = {cid: study.configs[cid] for cid in study.config_ids(kind)
+               if study.configs[cid].planner == planner}
+        for p in params:
+            values, _ = _sort_values(c.params[p] for c in cfg.values() if p in c.params)
+            for scope, skind, runs, pooled in _scopes(study):
+                if skind != kind:
+                    continue
+                for v in values:
+                    ids = {cid for cid, c in cfg.items()
+                           if p in c.params and _value_key(c.params[p]) == _value_key(v)}
+                    sel = [r for r in runs if r["plannerid"] in ids]
+                    if not sel:
+                        continue
+                    rows.append({"scope": scope, "pooled": pooled, "kind": kind,
+                                 "planner": planner,
+                                 "parameter": p, "value": _param_text(v),
+                                 "configs": len({r["plannerid"] for r in sel}),
+                                 **_group_stats(sel, rl)})
+    return rows
+
+
+# --------------------------------------------------------------------------- formatting
+def _pct_ci(row: Mapping[str, Any], key: str, count: str, n: str) -> str:
+    if not row[n]:
+        return "n/a"
+    return (f"{row[count]}/{row[n]} = {100 * row[key + '_rate']:.1f}% "
+            f"[{100 * row[key + '_ci_low']:.1f}, {100 * row[key + '_ci_high']:.1f}]")
+
+
+def _num_ci(row: Mapping[str, Any], base: str, unit: str = "", scale: float = 1.0,
+            fmt: str = "{:.3f}") -> str:
+    m = row[f"{base}_mean{unit}"]
+    if not np.isfinite(m):
+        return "n/a"
+    lo, hi = row[f"{base}_ci_low{unit}"] * scale, row[f"{base}_ci_high{unit}"] * scale
+    return f"{fmt.format(m * scale)} [{fmt.format(lo)}, {fmt.format(hi)}]"
+
+
+def _num(v: float, scale: float = 1.0, fmt: str = "{:.3f}") -> str:
+    return "n/a" if not np.isfinite(v) else fmt.format(v * scale)
+
+
+def _r_cell(row: Mapping[str, Any]) -> str:
+    if not row["r_length_pairs"]:
+        return "n/a"
+    m, lo, hi = row["r_length_mean"], row["r_length_ci_low"], row["r_length_ci_high"]
+    return f"{100 * m:+.2f}% [{100 * lo:+.2f}, {100 * hi:+.2f}]"
+
+
+def _table(rows: Sequence[Mapping[str, Any]], first: Sequence[tuple[str, str]],
+           dynamic: bool) -> list[list[str]]:
+    head = [h for h, _ in first] + [
+        "runs", "success [95% CI]", "errors", "not solved by status", "collision-free "
+        "(solved)"]
+    if dynamic:
+        head += ["collisions [95% CI]", "time to goal (s) mean [95% CI]", "median"]
+    head += ["length (m) mean [95% CI]", "median", "time (ms) mean [95% CI]", "median",
+             "R_length mean [95% CI]", "median", "pairs", "shorter"]
+    table = [head]
+    for r in rows:
+        line = [str(r[k]) for _, k in first] + [
+            str(r["runs"]), _pct_ci(r, "success", "solved", "runs"), str(r["errors"]),
+            r["failures"] or "-",
+            _pct_ci(r, "collision_free", "collision_free", "collision_checked")]
+        if dynamic:
+            line += [_pct_ci(r, "collision", "collision_runs", "runs"),
+                     _num_ci(r, "time_to_goal", "_s", fmt="{:.2f}"),
+                     _num(r["time_to_goal_median_s"], fmt="{:.2f}")]
+        line += [_num_ci(r, "length", "_m"), _num(r["length_median_m"]),
+                 _num_ci(r, "time", "_s", 1e3, "{:.4g}"),
+                 _num(r["time_median_s"], 1e3, "{:.4g}"),
+                 _r_cell(r),
+                 "n/a" if not r["r_length_pairs"] else f"{100 * r['r_length_median']:+.2f}%",
+                 str(r["r_length_pairs"]),
+                 f"{r['r_length_shorter']}/{r['r_length_pairs']}" if r["r_length_pairs"]
+                 else "n/a"]
+        table.append(line)
+    return table
+
+
+def _slug(text: str) -> str:
+    s = re.sub(r"[^A-Za-z0-9._-]+", "-", text).strip("-.")
+    return s or "x"
+
+
+def _csv_value(v: Any) -> Any:
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return ""
+    return v
+
+
+# --------------------------------------------------------------------------- the report
+@dataclass
+class _Section:
+    title: str
+    text: str = ""
+    table: list[list[str]] | None = None
+    images: list[tuple[str, str]] = field(default_factory=list)  # (file name, caption)
+    level: int = 2
+
+
+_NOTES = (
+    "runs counts every stored run (solved + not solved + errors). Runs that raised "
+    "(ERROR) are never dropped: they count as not solved. Success rate: solved / runs "
+    "with a 95% Wilson score interval. Collision-free: solved runs whose path is "
+    "collision-free / solved runs that were checked. Length (and time to goal) over solved "
+    "runs; planning time over every run that did not raise; means with a 95% Student-t "
+    "interval. R_length = (L - L_ref) / L_ref over the runs where the run and its "
+    "reference both solved the same problem (problem_key + seed); pairs = how many; "
+    "shorter = pairs where the configuration's path is shorter than the reference's. "
+    "R_length < 0: shorter than the reference."
+)
+
+
+def write_report(db_path: str | Path, out_dir: str | Path, reference: str | None = None,
+                 params: Sequence[str] | None = None, *, dpi: int = 110,
+                 embed_images: bool = True) -> dict[str, Path]:
+    """Write the report of a study database into ``out_dir`` (created if needed).
+
+    Parameters
+    ----------
+    db_path : path-like
+        The study database of ``pathfuse bench``.
+    out_dir : path-like
+        Output folder.
+    reference : str, optional
+        R_length reference: a planner configuration name, or a planner with
+        one configuration per run kind (default: the experiment's own
+        reference, stored with each run).
+    params : sequence of str, optional
+        Parameters to plot against success rate and length (default: every
+        swept parameter).
+    dpi : int
+        Resolution of the PNG figures.
+    embed_images : bool
+        Embed the figures in ``report.html`` as base64 (they are linked to
+        the PNG files either way).
+
+    Returns
+    -------
+    dict
+        Name -> path of every file written (``report_md``, ``report_html``,
+        ``summary_csv``, ``parameters_csv``, and one entry per figure).
+
+    Raises
+    ------
+    ConfigError
+        A bad database, reference or parameter name (one line).
+    """
+    return build_report(db_path, reference, params).write(out_dir, dpi=dpi,
+                                                          embed_images=embed_images)
+
+
+@dataclass
+class StudyReport:
+    """The numbers of a report (:func:`build_report`); :meth:`write` writes the files.
+
+    ``rows`` are :func:`summary_rows`, ``parameter_rows`` :func:`parameter_rows`,
+    ``r_length`` the run id -> R_length pairs, ``swept`` the plotted parameters.
+    """
+
+    study: Study
+    reference: str | None
+    reference_label: str
+    r_length: dict[int, float]
+    swept: dict[tuple[str, str], list[str]]
+    rows: list[dict[str, Any]]
+    parameter_rows: list[dict[str, Any]]
+
+    def write(self, out_dir: str | Path, *, dpi: int = 110,
+              embed_images: bool = True) -> dict[str, Path]:
+        """Write the files (see :func:`write_report`)."""
+        return _write(self, Path(out_dir), dpi, embed_images)
+
+
+def build_report(db_path: str | Path, reference: str | None = None,
+                 params: Sequence[str] | None = None) -> StudyReport:
+    """Read a study and compute every table of its report (arguments as
+    :func:`write_report`)."""
+    study = load_study(db_path)
+    rl = r_length_values(study, reference)
+    swept = swept_parameters(study, params)
+    return StudyReport(study, reference, _reference_label(study, reference), rl, swept,
+                       summary_rows(study, reference, rl),
+                       parameter_rows(study, swept, reference, rl))
+
+
+def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[str, Path]:
+    study, rl, ref_label, swept = rep.study, rep.r_length, rep.reference_label, rep.swept
+    rows, prows = rep.rows, rep.parameter_rows
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"{out}: cannot create the output folder ({exc.strerror})") from None
+    from pathfuse.viz import report as viz
+
+    files: dict[str, Path] = {
+        "report_md": out / "report.md",
+        "report_html": out / "report.html",
+        "summary_csv": out / "summary.csv",
+        "parameters_csv": out / "parameters.csv",
+    }
+    write_csv(files["summary_csv"], [{k: _csv_value(v) for k, v in r.items()} for r in rows])
+    if prows:
+        write_csv(files["parameters_csv"],
+                  [{k: _csv_value(v) for k, v in r.items()} for r in prows])
+    else:
+        files["parameters_csv"].write_text(
+            "scope,kind,planner,parameter,value,configs,runs\n", encoding="utf-8")
+
+    sections: list[_Section] = []
+    names = _scope_names(study)
+    used_slugs: set[str] = set()
+    exp_ids = sorted({r["experimentid"] for r in study.runs})
+    for eid in exp_ids:
+        scope = names[eid]
+        runs = [r for r in study.runs if r["experimentid"] == eid]
+        kind = runs[0]["kind"]
+        srows = [r for r in rows if r["scope"] == scope]
+        slug = _slug(scope)
+        if slug in used_slugs:
+            slug = f"{slug}-{eid}"
+        used_slugs.add(slug)
+        cids = sorted({r["plannerid"] for r in runs})
+        labels = [study.configs[c].name for c in cids]
+
+        def values(key: str, cids: list[int] = cids, runs: list[dict[str, Any]] = runs,
+                   scale: float = 1.0) -> list[np.ndarray]:
+            return [np.array([scale * float(r[key]) for r in runs if r["plannerid"] == c
+                              and r[key] is not None and r["status_name"] != "ERROR"
+                              and (key == "time" or r["solved"])], dtype=float)
+                    for c in cids]
+
+        sec = _Section(f"{scope} ({kind}, {len(runs)} runs)",
+                       text=f"Map entry `{study.experiments[eid].name}`.")
+        sec.table = _table(srows, [("configuration", "config")], kind == "dynamic")
+        name = f"length_{slug}.png"
+        viz.plot_boxes(labels, values("solution_length"), out / name,
+                       xlabel="path length [m] (solved runs)", title=f"{scope}: path length",
+                       dpi=dpi)
+        files[f"length_{slug}"] = out / name
+        sec.images.append((name, "Path length per configuration (solved runs)"))
+        name = f"time_{slug}.png"
+        viz.plot_boxes(labels, values("time", scale=1e3), out / name,
+                       xlabel="planning time [ms]", title=f"{scope}: planning time", dpi=dpi,
+                       log=True)
+        files[f"time_{slug}"] = out / name
+        sec.images.append((name, "Planning time per configuration (every run that did not "
+                                 "raise)"))
+        if kind == "dynamic":
+            name = f"time_to_goal_{slug}.png"
+            viz.plot_boxes(labels, values("time_to_goal"), out / name,
+                           xlabel="time to goal [s] (reached)",
+                           title=f"{scope}: time to goal", dpi=dpi)
+            files[f"time_to_goal_{slug}"] = out / name
+            sec.images.append((name, "Simulated time to goal (episodes that reached it)"))
+        rvals = [np.array([100 * rl[r["id"]] for r in runs
+                           if r["plannerid"] == c and r["id"] in rl]) for c in cids]
+        if any(v.size for v in rvals):
+            name = f"r_length_{slug}.png"
+            viz.plot_boxes(labels, rvals, out / name,
+                           xlabel="R_length = (L - L_ref) / L_ref [%]",
+                           title=f"{scope}: R_length against {ref_label}", dpi=dpi, zero=True)
+            files[f"r_length_{slug}"] = out / name
+            sec.images.append((name, f"R_length against {ref_label} (paired runs)"))
+        sections.append(sec)
+    for scope, kind, _, pooled in _scopes(study):
+        if not pooled:
+            continue
+        n_exp = len({r["experimentid"] for r in study.runs if r["kind"] == kind})
+        if n_exp < 2:
+            continue
+        srows = [r for r in rows if r["scope"] == scope]
+        sec = _Section(f"{scope}: every {kind} map entry pooled ({n_exp} entries)")
+        sec.table = _table(srows, [("configuration", "config")], kind == "dynamic")
+        runs = [r for r in study.runs if r["kind"] == kind]
+        cids = sorted({r["plannerid"] for r in runs})
+        rvals = [np.array([100 * rl[r["id"]] for r in runs
+                           if r["plannerid"] == c and r["id"] in rl]) for c in cids]
+        if any(v.size for v in rvals):
+            name = f"r_length_{_slug(scope)}_pooled.png"
+            viz.plot_boxes([study.configs[c].name for c in cids], rvals, out / name,
+                           xlabel="R_length = (L - L_ref) / L_ref [%]",
+                           title=f"{scope}: R_length against {ref_label}", dpi=dpi, zero=True)
+            files[f"r_length_{_slug(scope)}_pooled"] = out / name
+            sec.images.append((name, f"R_length against {ref_label}, every entry pooled"))
+        sections.append(sec)
+
+    if prows:
+        sections.append(_Section(
+            "Swept parameters",
+            text="For every parameter that takes several values among the configurations of "
+                 "a planner (or the parameters chosen with --param): the configurations "
+                 "sharing a value pooled over the other swept parameters, per map entry "
+                 "(and every entry of a kind pooled when there are several)."))
+    for (kind, planner), plist in swept.items():
+        n_exp = len({r["experimentid"] for r in study.runs if r["kind"] == kind})
+        for p in plist:
+            pr = [r for r in prows if r["kind"] == kind and r["planner"] == planner
+                  and r["parameter"] == p]
+            if not pr:
+                continue
+            tag = f"{planner}_{p}" if len(study.kinds) == 1 else f"{kind}_{planner}_{p}"
+            name = f"param_{_slug(tag)}.png"
+            exp_scopes = list(dict.fromkeys(r["scope"] for r in pr if not r["pooled"]))
+            lines = {}
+            for s in exp_scopes or [r["scope"] for r in pr[:1]]:
+                lines[s] = [r for r in pr if r["scope"] == s]
+            cfg_vals = [study.configs[c].params[p] for c in study.config_ids(kind)
+                        if study.configs[c].planner == planner and p in study.configs[c].params]
+            _, numeric = _sort_values(cfg_vals)
+            viz.plot_parameter(p, lines, out / name, numeric=numeric,
+                               title=f"{planner} ({kind}): {p}", dpi=dpi)
+            files[f"param_{_slug(tag)}"] = out / name
+            sec = _Section(f"{planner} ({kind}): parameter {p}", level=3,
+                           text=f"Every configuration of {planner} with the same value of "
+                                f"{p} pooled (over the other swept parameters).")
+            shown = [r for r in pr if not r["pooled"] or n_exp > 1]
+            sec.table = _table(shown, [("scope", "scope"), (p, "value"),
+                                       ("configs", "configs")], kind == "dynamic")
+            sec.images.append((name, f"{p} against success rate (95% Wilson) and mean length "
+                                     "(95% t)"))
+            sections.append(sec)
+
+    head = _header(study, ref_label, swept)
+    files["report_md"].write_text(_markdown(head, sections), encoding="utf-8")
+    files["report_html"].write_text(_html(study, head, sections, out, embed_images),
+                                    encoding="utf-8")
+    return files
+
+
+def _header(study: Study, ref_label: str, swept: Mapping[tuple[str, str], Sequence[str]]
+            ) -> list[str]:
+    n = len(study.runs)
+    solved = sum(r["solved"] for r in study.runs)
+    errors = sum(r["status_name"] == "ERROR" for r in study.runs)
+    studies = sorted({e.name.rsplit("/", 1)[0] for e in study.experiments.values()
+                      if "/" in e.name})
+    lines = [
+        f"Study database `{study.path}`"
+        + (f" (experiment{'s' if len(studies) > 1 else ''}: {', '.join(studies)})"
+           if studies else "") + ".",
+        f"{n} runs: {solved} solved, {n - solved - errors} not solved, {errors} errors; "
+        f"{_plural(len({r['experimentid'] for r in study.runs}), 'map entry', 'map entries')}, "
+        f"{_plural(len(study.config_ids()), 'planner configuration')}.",
+        f"R_length reference: {ref_label}.",
+    ]
+    if swept:
+        lines.append("Swept parameters: " + "; ".join(
+            f"{pl} ({k}): {', '.join(ps)}" for (k, pl), ps in swept.items()) + ".")
+    if study.sessions:
+        s0, s1 = study.sessions[0], study.sessions[-1]
+        hosts = sorted({s["host"] for s in study.sessions if s["host"]})
+        vers = sorted({s["pathfuse_version"] for s in study.sessions if s["pathfuse_version"]})
+        lines.append(f"{len(study.sessions)} bench session(s) from {s0['started_at']} to "
+                     f"{s1['finished_at'] or s1['started_at']} (last: {s1['state']}) on "
+                     f"{', '.join(hosts) or '?'}, pathfuse {', '.join(vers) or '?'}.")
+    return lines
+
+
+def _plural(n: int, one: str, many: str | None = None) -> str:
+    return f"{n} {one if n == 1 else (many or one + 's')}"
+
+
+def _markdown(head: Sequence[str], sections: Sequence[_Section]) -> str:
+    out = ["# pathfuse study report", "", *[f"{h}  " for h in head], "", _NOTES, ""]
+    for s in sections:
+        out += ["#" * s.level + " " + s.title, ""]
+        if s.text:
+            out += [s.text, ""]
+        if s.table:
+            out += [markdown_table(s.table), ""]
+        for name, cap in s.images:
+            out += [f"![{cap}]({name})", ""]
+    return "\n".join(out)
+
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em;
+color:#222;max-width:110em}
+h1{font-size:1.6em}h2{font-size:1.3em;margin-top:2em;border-bottom:1px solid #ccc}
+h3{font-size:1.1em;margin-top:1.5em}
+table{border-collapse:collapse;font-size:0.82em;margin:0.8em 0;display:block;overflow-x:auto}
+th,td{border:1px solid #ccc;padding:3px 6px;text-align:right;white-space:nowrap}
+th{background:#f0f0f0;position:sticky;top:0}
+td:first-child,th:first-child{text-align:left}
+tr:nth-child(even) td{background:#fafafa}
+figure{display:inline-block;margin:0.5em 1em 0.5em 0;vertical-align:top}
+figure img{max-width:100%;border:1px solid #ddd}
+figcaption{font-size:0.8em;color:#555}
+.notes{font-size:0.85em;color:#444;max-width:60em}
+"""
+
+
+def _html(study: Study, head: Sequence[str], sections: Sequence[_Section], out: Path,
+          embed: bool) -> str:
+    e = html.escape
+
+    def md_inline(text: str) -> str:
+        return re.sub(r"`([^`]*)`", r"<code>\1</code>", e(text))
+
+    parts = ["<!DOCTYPE html>", "<html lang='en'><head><meta charset='utf-8'>",
+             f"<title>pathfuse report: {e(study.path.name)}</title>",
+             f"<style>{_CSS}</style></head><body>",
+             "<h1>pathfuse study report</h1>"]
+    parts += [f"<p>{md_inline(h)}</p>" for h in head]
+    parts.append(f"<p class='notes'>{e(_NOTES)}</p>")
+    toc = [f"<li><a href='#s{i}'>{e(s.title)}</a></li>" for i, s in enumerate(sections)]
+    parts.append("<ul>" + "".join(toc) + "</ul>")
+    for i, s in enumerate(sections):
+        parts.append(f"<h{s.level} id='s{i}'>{e(s.title)}</h{s.level}>")
+        if s.text:
+            parts.append(f"<p>{md_inline(s.text)}</p>")
+        if s.table:
+            rows = ["<tr>" + "".join(f"<th>{e(c)}</th>" for c in s.table[0]) + "</tr>"]
+            rows += ["<tr>" + "".join(f"<td>{e(str(c))}</td>" for c in r) + "</tr>"
+                     for r in s.table[1:]]
+            parts.append("<table>" + "".join(rows) + "</table>")
+        for name, cap in s.images:
+            if embed:
+                data = base64.b64encode((out / name).read_bytes()).decode("ascii")
+                src = f"data:image/png;base64,{data}"
+            else:
+                src = e(name)
+            parts.append(f"<figure><a href='{e(name)}'><img src='{src}' alt='{e(cap)}' "
+                         f"title='{e(name)}'></a><figcaption>{e(cap)} "
+                         f"(<a href='{e(name)}'>{e(name)}</a>)</figcaption></figure>")
+    parts.append("</body></html>")
+    return "\n".join(parts)

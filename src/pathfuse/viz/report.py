@@ -91,11 +91,14 @@ def plot_parameter(param: str, lines: Mapping[str, Sequence[Mapping[str, Any]]],
         return np.array([cats.index(str(r["value"])) for r in rows], dtype=float)
 
     k = len(lines)
+    span = 1.0
+    if numeric and len(cats) > 1:
+        span = float(max(map(float, cats)) - min(map(float, cats)))
     for j, (label, rows) in enumerate(lines.items()):
         rows = sorted(rows, key=lambda r: cats.index(str(r["value"])))
         x = xs(rows)
-        if not numeric and k > 1:  # side by side
-            x = x + (j - (k - 1) / 2) * 0.08
+        if k > 1:  # side by side, so that the error bars of the lines do not hide each other
+            x = x + (j - (k - 1) / 2) * (0.08 if not numeric else 0.012 * span)
         sr = np.array([r["success_rate"] for r in rows], dtype=float)
         lo = np.array([r["success_ci_low"] for r in rows], dtype=float)
         hi = np.array([r["success_ci_high"] for r in rows], dtype=float)

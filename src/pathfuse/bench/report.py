@@ -816,7 +816,11 @@ def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[st
             text="For every parameter that takes several values among the configurations of "
                  "a planner (or the parameters chosen with --param): the configurations "
                  "sharing a value pooled over the other swept parameters, per map entry "
-                 "(and every entry of a kind pooled when there are several)."))
+                 "(and every entry of a kind pooled when there are several).  The pooled "
+                 "configurations ran on the same maps, so their runs are not independent and "
+                 "the intervals are narrower than they should be; for a paired comparison "
+                 "pick one configuration as --reference (R_length then pairs every run with "
+                 "that configuration's run on the same problem and seed)."))
     for (kind, planner), plist in swept.items():
         n_exp = len({r["experimentid"] for r in study.runs if r["kind"] == kind})
         for p in plist:

@@ -458,9 +458,9 @@ def cmd_report(args: argparse.Namespace) -> int:
     study, rows = report.study, report.rows
     pooled = {r["scope"] for r in rows if r["pooled"]}
     shown = [r for r in rows if r["scope"] in pooled]
-    print(f"{args.db}: {len(study.runs)} runs, "
-          f"{len({r['experimentid'] for r in study.runs})} map entries, "
-          f"{len(study.config_ids())} planner configurations")
+    n_exp, n_cfg = len({r["experimentid"] for r in study.runs}), len(study.config_ids())
+    print(f"{args.db}: {len(study.runs)} runs, {n_exp} map entr{'y' if n_exp == 1 else 'ies'}, "
+          f"{n_cfg} planner configuration{'' if n_cfg == 1 else 's'}")
     head = ("scope", "configuration", "runs", "success", "errors", "length mean", "R_length")
     table = [head]
     for r in shown:

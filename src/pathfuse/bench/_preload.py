@@ -25,6 +25,16 @@ def _warm() -> None:
         import pathfuse.metrics  # noqa: F401
     except Exception:  # noqa: BLE001
         pass
+    try:  # the dynamic world's kernels (online planners, geometry, moving discs)
+        from pathfuse.world.geometry import warmup_geometry
+        from pathfuse.world.obstacles import warmup_obstacles
+        from pathfuse.world.online import warmup_online
+
+        warmup_online()
+        warmup_geometry()
+        warmup_obstacles()
+    except Exception:  # noqa: BLE001
+        pass
 
 
 _warm()

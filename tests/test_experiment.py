@@ -34,8 +34,11 @@ def _never(grid, start, goal, params, budget):  # experiments are only expanded 
 
 
 # two planners of our own, so that these tests do not depend on the real ones
-register(PlannerSpec("xsweep", _never, _Params, "test planner for experiment parsing"))
-register(PlannerSpec("xother", _never, _Params, "second test planner"))
+# (registered for each test; conftest.py restores the registry afterwards)
+@pytest.fixture(autouse=True)
+def _test_planners():
+    register(PlannerSpec("xsweep", _never, _Params, "test planner for experiment parsing"))
+    register(PlannerSpec("xother", _never, _Params, "second test planner"))
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared" / "data" / "movingai"

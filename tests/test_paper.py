@@ -31,7 +31,8 @@ def test_mean_ci_matches_scipy_t_interval():
 def test_wilson_interval_known_values():
     # Wilson score interval for 8/10 at 95%: [0.4902, 0.9433] (textbook value)
     p, lo, hi = wilson_ci(8, 10)
-    assert p == 0.8 and lo == pytest.approx(0.4902, abs=1e-4) and hi == pytest.approx(0.9433, abs=1e-4)
+    assert p == 0.8
+    assert lo == pytest.approx(0.4902, abs=1e-4) and hi == pytest.approx(0.9433, abs=1e-4)
     assert wilson_ci(0, 5)[1] == 0.0 and wilson_ci(5, 5)[2] == 1.0
 
 

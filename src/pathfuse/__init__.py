@@ -33,7 +33,6 @@ from pathfuse.result import (
     QueryError,
     Status,
 )
-
 from pathfuse.world import Episode, EpisodeStatus, World, load_scenario, simulate
 
 __version__ = "0.1.0"

@@ -770,6 +770,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except PathfuseError as exc:
         print(f"pathfuse {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    except BrokenPipeError:  # output piped into e.g. `head`, which closed early
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except OSError as exc:
         where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
         print(f"pathfuse {args.command}: error:{where} {exc.strerror or exc}", file=sys.stderr)

@@ -168,7 +168,8 @@ class GridMap:
         """
         p = _as_points(xy)
         if not np.all(np.isfinite(p)):
-            raise MapError(f"coordinates must be finite, got {p[~np.isfinite(p).all(1)][0].tolist()}")
+            bad = p[~np.isfinite(p).all(axis=1)][0].tolist()
+            raise MapError(f"coordinates must be finite, got {bad}")
         col = np.floor((p[:, 0] - self.origin[0]) / self.resolution).astype(np.int64)
         row = np.floor((p[:, 1] - self.origin[1]) / self.resolution).astype(np.int64)
         return np.stack([row, col], axis=1)

@@ -94,7 +94,9 @@ class Budget:
         if self.max_iterations is not None and (
             not isinstance(self.max_iterations, (int, np.integer)) or self.max_iterations < 1
         ):
-            raise ConfigError(f"max_iterations must be a positive integer, got {self.max_iterations!r}")
+            raise ConfigError(
+                f"max_iterations must be a positive integer, got {self.max_iterations!r}"
+            )
         if self.time_limit_s is not None and not (
             isinstance(self.time_limit_s, (int, float)) and np.isfinite(self.time_limit_s)
             and self.time_limit_s > 0

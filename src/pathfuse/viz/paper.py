@@ -28,10 +28,10 @@ def plot_fig3(run: PaperRun, out: str | Path, dpi: int = 120) -> None:
     refs = [(k, tag) for k, tag in _FIG3_ORDER if (seed, k) in run.results]
     ncol = 2
     nrow = max(1, (len(refs) + 1) // 2)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(10, 5 * nrow), squeeze=False)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(10, 5.8 * nrow), squeeze=False)
     for ax in axes.ravel()[len(refs):]:
         ax.axis("off")
-    for ax, (name, tag) in zip(axes.ravel(), refs):
+    for ax, (name, tag) in zip(axes.ravel(), refs, strict=False):
         draw_map(ax, grid)
         if fusion is not None and "astar_path" in fusion.info:
             a = np.asarray(fusion.info["astar_path"])
@@ -46,7 +46,8 @@ def plot_fig3(run: PaperRun, out: str | Path, dpi: int = 120) -> None:
         ax.plot(*PAPER_START, "o", color="#2ca02c", ms=9, mec="k", zorder=5, label="start")
         ax.plot(*PAPER_GOAL, "*", color="#ffbf00", ms=14, mec="k", zorder=5, label="goal")
         ax.set_title(f"{tag} compared with {PAPER_LABELS.get(name, name)}", fontsize=10)
-        ax.legend(loc="upper left", fontsize=7, framealpha=0.9)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize=7,
+                  frameon=False)
     fig.suptitle(f"Fusion path against the references, paper-setup map seed {seed}")
     fig.tight_layout()
     fig.savefig(out, dpi=dpi)

@@ -212,7 +212,9 @@ class GridMap:
         A cell becomes occupied when its centre lies closer than ``radius_m``
         to an occupied cell (the cell taken as a square, not as its centre),
         so a disc of that radius centred on any free cell centre touches no
-        obstacle.  ``radius_m = 0`` returns an equal map.
+        obstacle.  ``radius_m = 0`` returns an equal map.  The grown map is
+        cached per radius, so planners that inflate on every query (and the
+        A* buffers kept per map) are not rebuilt each time.
 
         >>> g = GridMap.from_rows([".....", ".....", "..#..", ".....", "....."])
         >>> int(g.inflate(0.4).occupied.sum()), int(g.inflate(0.6).occupied.sum())
@@ -221,6 +223,18 @@ class GridMap:
         r = float(radius_m)
         if not np.isfinite(r) or r < 0:
             raise MapError(f"inflation radius must be a finite number >= 0, got {radius_m!r}")
+        cache = self._inflated
+        if r not in cache:
+            if len(cache) >= 4:
+                cache.pop(next(iter(cache)))
+            cache[r] = self._inflate(r)
+        return cache[r]
+
+    @cached_property
+    def _inflated(self) -> dict[float, GridMap]:
+        return {}
+
+    def _inflate(self, r: float) -> GridMap:
         if r == 0 or not self.occupied.any():
             return self.with_occupied(self.occupied.copy())
         # distance from a cell centre to the nearest point of an occupied square

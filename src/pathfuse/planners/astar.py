@@ -217,3 +217,36 @@ register(
         warmup=warmup,
     )
 )
+
+
+def global_astar(
+    grid: GridMap,
+    start: np.ndarray,
+    goal: np.ndarray,
+    robot_radius_m: float = 0.0,
+    time_limit_s: float | None = None,
+) -> tuple[PlanResult, dict]:
+    """Step 1 of the A*-based hybrids (fusion, ref6, ref7): the global A* path.
+
+    A* runs with the paper's settings (Euclidean heuristic, no corner
+    cutting) on the map grown by ``robot_radius_m``.  Returns the A* result
+    and the ``info`` entries every hybrid reports: ``astar_path`` ((N, 2)
+    cell centres), ``astar_length`` and ``astar_time_s``.
+    """
+    agrid = grid.inflate(robot_radius_m) if robot_radius_m > 0 else grid
+    ares = plan_astar(agrid, start, goal, _HYBRID_PARAMS, Budget(time_limit_s=time_limit_s))
+    info = {
+        "astar_path": np.asarray(ares.path, dtype=np.float64).reshape(-1, 2),
+        "astar_length": float(ares.length),
+        "astar_time_s": float(ares.time_s),
+    }
+    return ares, info
+
+
+def astar_failed(ares: PlanResult, planner: str, info: dict) -> PlanResult:
+    """The result of a hybrid whose A* step failed: A*'s status, an empty path."""
+    return PlanResult(ares.status, np.zeros((0, 2)), 0.0, ares.time_s, planner,
+                      ares.expansions, 0, f"A* failed: {ares.message}", info)
+
+
+_HYBRID_PARAMS = AStarParams(heuristic="euclidean", corner_cutting=False)

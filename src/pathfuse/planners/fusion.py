@@ -100,12 +100,12 @@ from pathfuse.field.stepper import (
     polyline_cumlen,
 )
 from pathfuse.grid import GridMap
-from pathfuse.planners.astar import AStarParams, plan_astar
-from pathfuse.planners.registry import PlannerSpec, get_planner, register
+from pathfuse.planners.astar import astar_failed, global_astar
+from pathfuse.planners.astar import warmup as astar_warmup
+from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.result import Budget, ConfigError, PlanResult, Status
 
 #: A* settings of step 1: the paper's Euclidean heuristic, no corner cutting.
-_ASTAR_PARAMS = AStarParams(heuristic="euclidean", corner_cutting=False)
 
 __all__ = [
     "FUSION_STEP_FRAC",
@@ -354,13 +354,9 @@ def plan_fusion(
     budget = budget or Budget()
     start = np.asarray(start, dtype=np.float64).reshape(2)
     goal = np.asarray(goal, dtype=np.float64).reshape(2)
-    agrid = grid.inflate(p.robot_radius_m) if p.robot_radius_m > 0 else grid
-    ares = plan_astar(agrid, start, goal, _ASTAR_PARAMS, Budget(time_limit_s=budget.time_limit_s))
-    info = {"astar_path": ares.path, "astar_time_s": ares.time_s,
-            "astar_length": float(ares.length)}
+    ares, info = global_astar(grid, start, goal, p.robot_radius_m, budget.time_limit_s)
     if not ares.success:
-        return PlanResult(ares.status, np.zeros((0, 2)), 0.0, ares.time_s, "fusion",
-                          ares.expansions, 0, f"A* failed: {ares.message}", info)
+        return astar_failed(ares, "fusion", info)
     deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
     out, state, st, elapsed = _step2(grid, start, goal, ares.path, p, budget, deadline)
     return _result(out, state, st, goal, p, ares.time_s + elapsed, ares.expansions, info)
@@ -368,12 +364,7 @@ def plan_fusion(
 
 def warmup() -> None:
     """Compile (or load from numba's cache) A* and the fusion kernels on a tiny map."""
-    try:
-        spec = get_planner("astar")
-        if spec.warmup is not None:
-            spec.warmup()
-    except ConfigError:  # pragma: no cover - A* not registered
-        pass
+    astar_warmup()
     g = GridMap.from_rows(["....", ".#..", "...."])
     s, e = np.array([0.5, 0.5]), np.array([3.5, 2.5])
     path = np.array([[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]])

@@ -116,7 +116,9 @@ from pathfuse.field.stepper import (
     safe_step,
 )
 from pathfuse.grid import GridMap
-from pathfuse.planners.registry import PlannerSpec, get_planner, register
+from pathfuse.planners.astar import astar_failed, global_astar
+from pathfuse.planners.astar import warmup as astar_warmup
+from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.result import Budget, ConfigError, PlanResult, Status, path_length
 
 __all__ = [
@@ -497,23 +499,16 @@ def plan_ref6(
     points and stepping.  ``Budget.max_iterations`` caps the APF steps (A*
     runs with the time limit only); ``Budget.time_limit_s`` covers both.
     """
-    from pathfuse.planners.astar import AStarParams, plan_astar
-
     t0 = time.perf_counter()
     p = params or Ref6Params()
     budget = budget or Budget()
     start = np.asarray(start, dtype=np.float64).reshape(2)
     goal = np.asarray(goal, dtype=np.float64).reshape(2)
     deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
-    agrid = grid.inflate(p.robot_radius_m) if p.robot_radius_m > 0 else grid
-    ares = plan_astar(agrid, start, goal, AStarParams(), Budget(time_limit_s=budget.time_limit_s))
-    apath = np.asarray(ares.path, dtype=np.float64).reshape(-1, 2)
-    base = {"astar_path": apath, "astar_length": float(ares.length),
-            "astar_time_s": float(ares.time_s)}
+    ares, base = global_astar(grid, start, goal, p.robot_radius_m, budget.time_limit_s)
+    apath = base["astar_path"]
     if not ares.success:
-        return PlanResult(ares.status, np.zeros((0, 2)), 0.0, ares.time_s, "ref6",
-                          ares.expansions, 0, f"A* failed: {ares.message}",
-                          {**base, "subgoals": np.zeros((0, 2))})
+        return astar_failed(ares, "ref6", {**base, "subgoals": np.zeros((0, 2))})
     t1 = time.perf_counter()
     res = follow_subgoals(grid, start, goal, inflection_points(apath), p, budget,
                           deadline=deadline)
@@ -525,12 +520,7 @@ def plan_ref6(
 
 def warmup() -> None:
     """Compile (or load from numba's cache) A* and the ref [6] kernels on a tiny map."""
-    try:
-        spec = get_planner("astar")
-        if spec.warmup is not None:
-            spec.warmup()
-    except ConfigError:  # pragma: no cover - A* not registered
-        pass
+    astar_warmup()
     g = GridMap.from_rows(["....", ".#..", "...."])
     s, e = np.array([0.5, 0.5]), np.array([3.5, 2.5])
     subs = np.array([[2.5, 0.5], [3.5, 1.5]])

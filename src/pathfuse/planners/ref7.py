@@ -76,8 +76,10 @@ from pathfuse.field.driver import (
 from pathfuse.field.forces import K_ATT, K_REP, RHO0_M
 from pathfuse.field.stepper import apf_run, pack_apf
 from pathfuse.grid import GridMap
-from pathfuse.planners.registry import PlannerSpec, get_planner, register
-from pathfuse.result import Budget, ConfigError, PlanResult, Status, path_length
+from pathfuse.planners.astar import astar_failed, global_astar
+from pathfuse.planners.astar import warmup as astar_warmup
+from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.result import Budget, PlanResult, Status, path_length
 
 __all__ = ["Ref7Params", "plan_ref7", "follow_segments", "segment_ends", "warmup"]
 
@@ -282,24 +284,17 @@ def plan_ref7(
     stepping.  ``Budget.max_iterations`` caps the APF steps over all segments
     (A* runs with the time limit only); ``Budget.time_limit_s`` covers both.
     """
-    from pathfuse.planners.astar import AStarParams, plan_astar
-
     t0 = time.perf_counter()
     p = params or Ref7Params()
     budget = budget or Budget()
     start = np.asarray(start, dtype=np.float64).reshape(2)
     goal = np.asarray(goal, dtype=np.float64).reshape(2)
     deadline = t0 + budget.time_limit_s if budget.time_limit_s is not None else None
-    agrid = grid.inflate(p.robot_radius_m) if p.robot_radius_m > 0 else grid
-    ares = plan_astar(agrid, start, goal, AStarParams(), Budget(time_limit_s=budget.time_limit_s))
-    apath = np.asarray(ares.path, dtype=np.float64).reshape(-1, 2)
-    base = {"astar_path": apath, "astar_length": float(ares.length),
-            "astar_time_s": float(ares.time_s)}
+    ares, base = global_astar(grid, start, goal, p.robot_radius_m, budget.time_limit_s)
+    apath = base["astar_path"]
     if not ares.success:
-        return PlanResult(ares.status, np.zeros((0, 2)), 0.0, ares.time_s, "ref7",
-                          ares.expansions, 0, f"A* failed: {ares.message}",
-                          {**base, "segments": np.zeros((0, 2)),
-                           "segment_index": np.zeros(0, dtype=np.int64)})
+        return astar_failed(ares, "ref7", {**base, "segments": np.zeros((0, 2)),
+                                            "segment_index": np.zeros(0, dtype=np.int64)})
     t1 = time.perf_counter()
     idx = segment_ends(apath, p.segment_length_m, p.segment_points)
     ends = apath[idx]
@@ -313,13 +308,10 @@ def plan_ref7(
 
 def warmup() -> None:
     """Compile (or load from numba's cache) A* and the APF kernel on a tiny map."""
-    for name in ("astar", "apf"):
-        try:
-            spec = get_planner(name)
-            if spec.warmup is not None:
-                spec.warmup()
-        except ConfigError:  # pragma: no cover - not registered
-            pass
+    from pathfuse.planners.apf import warmup as apf_warmup
+
+    astar_warmup()
+    apf_warmup()
     g = GridMap.from_rows(["....", ".#..", "...."])
     follow_segments(g, np.array([0.5, 0.5]), np.array([3.5, 2.5]), np.array([[2.5, 0.5]]))
 

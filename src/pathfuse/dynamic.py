@@ -29,10 +29,7 @@ Examples
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-import sys
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -223,24 +220,6 @@ def _worker_init() -> None:
     warmup_online()
 
 
-@contextlib.contextmanager
-def _main_file_hidden() -> Iterator[None]:
-    """Hide ``__main__.__file__`` while workers start when it names no file (a script read
-    from stdin): fork-server and spawn workers would try to re-import it and die.  The
-    workers run only pathfuse code."""
-    main = sys.modules.get("__main__")
-    path = getattr(main, "__file__", None)
-    hide = path is not None and getattr(main, "__spec__", None) is None \
-        and not os.path.isfile(path)
-    if hide:
-        del main.__file__  # type: ignore[union-attr]
-    try:
-        yield
-    finally:
-        if hide:
-            main.__file__ = path  # type: ignore[union-attr]
-
-
 def _run_pool(tasks: list[Any], workers: int
               ) -> Iterator[tuple[tuple[int, int], list[dict[str, Any]]]]:
     """Yield ``((moving, index), records)`` as worker processes finish scenarios."""
@@ -253,7 +232,9 @@ def _run_pool(tasks: list[Any], workers: int
         ctx.set_forkserver_preload(["pathfuse.dynamic", "pathfuse.world"])
     else:  # pragma: no cover - Windows
         ctx = mp.get_context("spawn")
-    with _main_file_hidden():
+    from pathfuse.bench.runner import _main_without_file
+
+    with _main_without_file():
         ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init)
         try:
             futs = {ex.submit(_run_task, t): (t[0], t[1]) for t in tasks}

@@ -29,7 +29,7 @@ def assert_one_line_error(proc, *fragments):
 def test_help_of_every_command_shows_an_example():
     top = run("--help")
     assert top.returncode == 0 and "examples:" in top.stdout
-    for cmd in ("plan", "scen", "planners", "paper"):
+    for cmd in ("plan", "scen", "planners", "paper", "simulate", "dynamic", "bench", "report"):
         p = run(cmd, "--help")
         assert p.returncode == 0, p.stderr
         assert "example" in p.stdout and f"pathfuse {cmd}" in p.stdout

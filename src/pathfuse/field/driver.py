@@ -48,6 +48,7 @@ __all__ = [
     "check_positive",
     "check_nonneg",
     "check_int",
+    "check_stepping_params",
 ]
 
 #: Default step, as a fraction of the map resolution (see :func:`resolve_stepping`).
@@ -93,6 +94,23 @@ def check_int(name: str, value: Any, minimum: int) -> None:
     """ConfigError naming ``name`` unless ``value`` is an integer >= ``minimum``."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
         raise ConfigError(f"{name} must be an integer >= {minimum}, got {value!r}")
+
+
+def check_stepping_params(p: Any) -> None:
+    """Check the parameters every stepping planner shares (APF, fusion, ref6, ref7).
+
+    ``p`` has ``k_att``, ``k_rep``, ``rho0_m``, ``step_m``, ``goal_tolerance_m``,
+    ``robot_radius_m``, ``stall_steps`` and ``stall_distance_m``; a bad one is a
+    :class:`ConfigError` naming it.
+    """
+    check_positive("k_att", p.k_att)
+    check_nonneg("k_rep", p.k_rep)
+    check_positive("rho0_m", p.rho0_m)
+    check_positive("step_m", p.step_m, optional=True)
+    check_positive("goal_tolerance_m", p.goal_tolerance_m, optional=True)
+    check_nonneg("robot_radius_m", p.robot_radius_m)
+    check_int("stall_steps", p.stall_steps, 1)
+    check_positive("stall_distance_m", p.stall_distance_m, optional=True)
 
 
 @dataclass(frozen=True)

@@ -49,9 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pathfuse.field.driver import (
-    check_int,
-    check_nonneg,
-    check_positive,
+    check_stepping_params,
     drive,
     failure_message,
     outcome,
@@ -104,15 +102,7 @@ class APFParams:
     stall_distance_m: float | None = None
 
     def __post_init__(self) -> None:
-        check_positive("k_att", self.k_att)
-        check_nonneg("k_rep", self.k_rep)
-        check_positive("rho0_m", self.rho0_m)
-        check_positive("step_m", self.step_m, optional=True)
-        check_positive("goal_tolerance_m", self.goal_tolerance_m, optional=True)
-        check_nonneg("robot_radius_m", self.robot_radius_m)
-        check_int("stall_steps", self.stall_steps, 1)
-        check_positive("stall_distance_m", self.stall_distance_m, optional=True)
-
+        check_stepping_params(self)
 
 
 def force_at(

@@ -77,8 +77,8 @@ import numpy as np
 
 from pathfuse.field.driver import (
     check_int,
-    check_nonneg,
     check_positive,
+    check_stepping_params,
     drive,
     failure_message,
     outcome,
@@ -173,20 +173,13 @@ class FusionParams:
     escape_points: int = 3
 
     def __post_init__(self) -> None:
-        check_positive("k_att", self.k_att)
-        check_nonneg("k_rep", self.k_rep)
-        check_positive("rho0_m", self.rho0_m)
+        check_stepping_params(self)
         check_positive("r1_m", self.r1_m)
         check_positive("r2_m", self.r2_m)
         if self.ahead not in _AHEAD:
             raise ConfigError(
                 f"ahead must be one of {', '.join(repr(a) for a in _AHEAD)}, got {self.ahead!r}"
             )
-        check_positive("step_m", self.step_m, optional=True)
-        check_positive("goal_tolerance_m", self.goal_tolerance_m, optional=True)
-        check_nonneg("robot_radius_m", self.robot_radius_m)
-        check_int("stall_steps", self.stall_steps, 1)
-        check_positive("stall_distance_m", self.stall_distance_m, optional=True)
         if not isinstance(self.escape, (bool, np.bool_)):
             raise ConfigError(f"escape must be true or false, got {self.escape!r}")
         check_int("escape_points", self.escape_points, 1)

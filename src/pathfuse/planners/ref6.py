@@ -90,9 +90,8 @@ import numpy as np
 from numba import njit
 
 from pathfuse.field.driver import (
-    check_int,
-    check_nonneg,
     check_positive,
+    check_stepping_params,
     drive,
     failure_message,
     resolve_stepping,
@@ -179,15 +178,8 @@ class Ref6Params:
     rep_target: str = "subgoal"
 
     def __post_init__(self) -> None:
-        check_positive("k_att", self.k_att)
-        check_nonneg("k_rep", self.k_rep)
-        check_positive("rho0_m", self.rho0_m)
-        check_positive("step_m", self.step_m, optional=True)
-        check_positive("goal_tolerance_m", self.goal_tolerance_m, optional=True)
+        check_stepping_params(self)
         check_positive("subgoal_tolerance_m", self.subgoal_tolerance_m, optional=True)
-        check_nonneg("robot_radius_m", self.robot_radius_m)
-        check_int("stall_steps", self.stall_steps, 1)
-        check_positive("stall_distance_m", self.stall_distance_m, optional=True)
         check_positive("rep_exponent", self.rep_exponent)
         check_positive("rep_scale_m", self.rep_scale_m, optional=True)
         if self.rep_target not in _TARGETS:

@@ -67,8 +67,8 @@ import numpy as np
 
 from pathfuse.field.driver import (
     check_int,
-    check_nonneg,
     check_positive,
+    check_stepping_params,
     drive,
     failure_message,
     resolve_stepping,
@@ -116,18 +116,11 @@ class Ref7Params:
     stall_distance_m: float | None = None
 
     def __post_init__(self) -> None:
-        check_positive("k_att", self.k_att)
-        check_nonneg("k_rep", self.k_rep)
-        check_positive("rho0_m", self.rho0_m)
+        check_stepping_params(self)
         check_positive("segment_length_m", self.segment_length_m)
         if self.segment_points is not None:
             check_int("segment_points", self.segment_points, 1)
-        check_positive("step_m", self.step_m, optional=True)
-        check_positive("goal_tolerance_m", self.goal_tolerance_m, optional=True)
         check_positive("segment_tolerance_m", self.segment_tolerance_m, optional=True)
-        check_nonneg("robot_radius_m", self.robot_radius_m)
-        check_int("stall_steps", self.stall_steps, 1)
-        check_positive("stall_distance_m", self.stall_distance_m, optional=True)
 
 
 def segment_ends(

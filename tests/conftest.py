@@ -1,24 +1,23 @@
-"""Shared test set-up: keep the planner registries as the library ships them.
+"""Shared test set-up: keep the planner registry as the library ships it.
 
 Some tests register plug-in planners (directly, or by running an experiment
-whose ``imports:`` registers one).  Each test gets the registries back as they
-were before it ran, so no test sees another test's plug-ins.
+whose ``imports:`` registers one).  Each test gets the registry back as it
+was before it ran, so no test sees another test's plug-ins.
 """
 
 import pytest
 
 from pathfuse.planners import registry
-from pathfuse.world import online
 
 
 @pytest.fixture(autouse=True)
-def _restore_planner_registries():
+def _restore_planner_registry():
     registry.planner_names()  # make sure the built-in planners are loaded first
-    online.online_planner_names()
     saved = dict(registry.REGISTRY)
-    saved_online = dict(online.ONLINE_REGISTRY)
+    saved_aliases = dict(registry._ALIASES)
     yield
     registry.REGISTRY.clear()
     registry.REGISTRY.update(saved)
-    online.ONLINE_REGISTRY.clear()
-    online.ONLINE_REGISTRY.update(saved_online)
+    registry._ALIASES.clear()
+    registry._ALIASES.update(saved_aliases)
+    registry._DEFAULTS.clear()

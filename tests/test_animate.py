@@ -26,7 +26,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "scenarios"
 
 @pytest.fixture(scope="module")
 def collision_ep():
-    ep = simulate(EXAMPLES / "head_on.yaml", planner="astar-follow")
+    ep = simulate(EXAMPLES / "head_on.yaml", planner="astar")
     assert ep.status.name == "COLLISION"
     return ep
 
@@ -34,7 +34,7 @@ def collision_ep():
 @pytest.fixture(scope="module")
 def reached_ep():
     ep = simulate(EXAMPLES / "head_on.yaml", planner="fusion")
-    assert ep.status.name == "REACHED"
+    assert ep.status.name == "SUCCESS"
     return ep
 
 
@@ -96,8 +96,8 @@ def test_default_gif_of_a_long_episode_stays_small(tmp_path):
     # a 60 m corridor at 1 m/s: ~600 ticks; the default must not write 600 frames
     sc = {"map": {"rows": ["." * 62] * 2}, "start": [0.5, 1.0], "goal": [61.5, 1.0],
           "time_limit": 70, "robot": {"radius": 0.2}}
-    ep = simulate(sc, planner="astar-follow")
-    assert ep.status.name == "REACHED" and ep.n_ticks > 590
+    ep = simulate(sc, planner="astar")
+    assert ep.status.name == "SUCCESS" and ep.n_ticks > 590
     info = animate_episode(ep, tmp_path / "long.gif", dpi=30)
     assert info.frame_step == auto_frame_step(ep.n_ticks, 0.1, 10.0)
     n = Image.open(info.path).n_frames
@@ -111,7 +111,7 @@ def test_single_tick_episode_gives_a_one_frame_gif(tmp_path):
     # no path at all: the robot never moves, one tick to draw
     sc = {"map": {"rows": ["..#..", "..#..", "..#.."]}, "start": [0.5, 1.5],
           "goal": [4.5, 1.5]}
-    ep = simulate(sc, planner="astar-follow")
+    ep = simulate(sc, planner="astar")
     assert ep.status.name == "NO_PATH" and ep.n_ticks == 0
     info = animate_episode(ep, tmp_path / "one.gif", dpi=30)
     assert info.n_frames == 1 and Image.open(info.path).n_frames == 1

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import time
 
 import numpy as np
@@ -11,8 +12,9 @@ import pytest
 from pathfuse import Budget, ConfigError, GridMap, Status, plan
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate, path_length
-from pathfuse.planners.apf import APFParams, force_at, plan_apf
+from pathfuse.planners.apf import APFController, APFParams, force_at
 from pathfuse.planners.registry import get_planner
+from pathfuse.planners.run import warm
 
 
 def transform(grid: GridMap, quarter_turns: int, mirror: bool):
@@ -56,8 +58,12 @@ U_TRAP = GridMap.from_rows([
 def test_registered():
     spec = get_planner("apf")
     assert spec.params_cls is APFParams and not spec.uses_astar
-    assert spec.description and callable(spec.warmup)
-    spec.warmup()
+    assert spec.global_planner is None and spec.controller is APFController
+    assert spec.offline and spec.online and spec.description
+    assert callable(spec.controller.warmup)
+    warm(spec)
+    # robot_radius_m is part of the problem (a keyword of plan()), not a planner parameter
+    assert "robot_radius_m" not in spec.defaults()
 
 
 def test_open_map_goes_straight():
@@ -193,21 +199,43 @@ def test_force_at_matches_formula():
 
 
 @pytest.mark.parametrize("bad", [
-    {"k_att": -1}, {"k_att": "40"}, {"k_rep": -0.5}, {"rho0_m": 0}, {"step_m": 0.0},
-    {"step_m": float("nan")}, {"goal_tolerance_m": -1.0}, {"robot_radius_m": -0.1},
+    {"k_att": -1}, {"k_att": "forty"}, {"k_att": True}, {"k_rep": -0.5}, {"rho0_m": 0},
+    {"step_m": 0.0}, {"step_m": float("nan")}, {"goal_tolerance_m": -1.0},
     {"stall_steps": 0}, {"stall_steps": 2.5}, {"stall_distance_m": 0},
 ])
 def test_bad_params_name_the_value(bad):
     (key, value), = bad.items()
-    with pytest.raises(ConfigError, match=key):
+    # one format: KEY: must be WHAT, got VALUE (the key prefixed by the planner's name)
+    want = rf"^apf\.{key}: must be .+, got {re.escape(repr(value))}$"
+    with pytest.raises(ConfigError, match=want):
         plan(paper_map(0), PAPER_START, PAPER_GOAL, planner="apf", **bad)
-    with pytest.raises(ConfigError):
+    with pytest.raises(ConfigError, match=rf"^{key}: must be .+, got {re.escape(repr(value))}$"):
         APFParams(**bad)
+
+
+def test_numeric_strings_are_read_as_numbers():
+    # the shared validator accepts what YAML 1.1 reads as a string ("1e-2"), normalised
+    assert APFParams(k_att="40").k_att == 40.0 and isinstance(APFParams(k_att="40").k_att, float)
+    g = GridMap(np.zeros((3, 12), dtype=bool))
+    a = plan(g, (0.5, 1.5), (10.5, 1.5), planner="apf", step_m="3e-1")
+    b = plan(g, (0.5, 1.5), (10.5, 1.5), planner="apf", step_m=0.3)
+    assert a.success and np.array_equal(a.path, b.path) and a.info["step_m"] == 0.3
+
+
+@pytest.mark.parametrize("radius", [-0.1, float("nan"), float("inf"), "big"])
+def test_bad_robot_radius_is_a_problem_error(radius):
+    with pytest.raises(ConfigError,
+                       match=rf"^robot_radius_m: must be a finite number >= 0, got "
+                             rf"{re.escape(repr(radius))}$"):
+        plan(paper_map(0), PAPER_START, PAPER_GOAL, planner="apf", robot_radius_m=radius)
+    # it is no longer a planner parameter
+    with pytest.raises(TypeError):
+        APFParams(robot_radius_m=0.3)
 
 
 def test_info_and_timing():
     g = paper_map(3)
-    r = plan_apf(g, np.array(PAPER_START), np.array(PAPER_GOAL))
+    r = plan(g, PAPER_START, PAPER_GOAL, planner="apf")
     assert r.info["step_m"] == pytest.approx(0.1) and r.info["goal_tolerance_m"] == 0.1
     assert 0 < r.info["step_time_s"] <= r.time_s
     assert r.iterations >= 1 and r.length == pytest.approx(path_length(r.path))

@@ -7,6 +7,7 @@ import gc
 import math
 import os
 import time
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -18,11 +19,13 @@ from scipy.sparse.csgraph import dijkstra
 
 import pathfuse
 import pathfuse.search.astar as astar_mod
-from pathfuse import Budget, ConfigError, GridMap, QueryError, Status
+from pathfuse import Budget, ConfigError, GridMap, MapError, QueryError, Status
 from pathfuse.io.movingai import read_movingai
 from pathfuse.io.scenario import read_scen, scen_map_name
-from pathfuse.planners.astar import AStarParams, astar_cells, plan_astar
+from pathfuse.planners.astar import AStarParams, FollowController
 from pathfuse.planners.registry import get_planner
+from pathfuse.planners.run import warm
+from pathfuse.problem import Problem
 from pathfuse.search.astar import AStarSearcher, get_searcher
 
 DATA = Path(__file__).parent / "data" / "movingai"
@@ -136,9 +139,10 @@ def test_shared_scenarios_every_line(scen):
     g = read_movingai(map_path)
     probs = read_scen(scen, g)
     assert probs
+    searcher = get_searcher(g)
     for p in probs[::every]:
-        r = astar_cells(g, p.start_cell, p.goal_cell, heuristic="octile")
-        assert r.status == "SUCCESS", (scen.name, p.line)
+        r = searcher.search(p.start_cell, p.goal_cell, heuristic="octile")
+        assert r.status is Status.SUCCESS, (scen.name, p.line)
         assert r.cost == pytest.approx(p.optimal_length, rel=1e-6), (scen.name, p.line)
 
 
@@ -305,32 +309,57 @@ def test_bad_queries_through_plan(den):
     assert pathfuse.plan(den, ok, wall).status is Status.GOAL_OCCUPIED
     with pytest.raises(QueryError, match="start"):
         pathfuse.plan(den, (np.nan, 1.0), ok)
-    # called directly (as the fusion planner does), the same checks hold
-    r = plan_astar(den, ok, wall, AStarParams(), Budget())
-    assert r.status is Status.GOAL_OCCUPIED and r.planner == "astar"
-    with pytest.raises(QueryError):
-        plan_astar(den, ok, (1.0, np.inf), AStarParams(), Budget())
+    r = pathfuse.plan(den, ok, wall)
+    assert r.planner == "astar" and r.path.shape == (0, 2) and "occupied" in r.message
+    # the same checks hold for every planner: they live in the problem, checked once
+    assert Problem.create(den, ok, wall).failure()[0] is Status.GOAL_OCCUPIED
+    assert Problem.create(den, wall, ok).failure()[0] is Status.START_OCCUPIED
+    assert Problem.create(den, ok, out).failure()[0] is Status.GOAL_OUT_OF_BOUNDS
+    assert Problem.create(den, ok, ok).failure() is None
+    with pytest.raises(QueryError, match=r"^goal: must be finite, got"):
+        Problem.create(den, ok, (1.0, np.inf))
+    with pytest.raises(QueryError, match=r"^goal: must be two numbers \(x, y\), got"):
+        pathfuse.plan(den, ok, (1.0, 2.0, 3.0))
 
 
 def test_params_validation():
     g = GridMap.from_rows(["..", ".."])
-    with pytest.raises(ConfigError, match="'manhattan'"):
+    with pytest.raises(ConfigError, match=r"^astar\.heuristic: must be one of 'euclidean', "
+                                          r"'octile', got 'manhattan'$"):
         pathfuse.plan(g, (0.5, 0.5), (1.5, 1.5), heuristic="manhattan")
-    with pytest.raises(ConfigError, match="corner_cutting.*'yes'"):
+    with pytest.raises(ConfigError,
+                       match=r"^astar\.corner_cutting: must be true or false, got 'yes'$"):
         pathfuse.plan(g, (0.5, 0.5), (1.5, 1.5), corner_cutting="yes")
-    with pytest.raises(ConfigError, match="no parameter 'heuristc'"):
+    with pytest.raises(ConfigError, match=r"^astar\.heuristc: unknown parameter "
+                                          r"\(parameters: heuristic, corner_cutting\)$"):
         pathfuse.plan(g, (0.5, 0.5), (1.5, 1.5), heuristc="octile")
-    with pytest.raises(QueryError, match="occupied"):
-        astar_cells(GridMap.from_rows([".#"]), (0, 0), (0, 1))
-    with pytest.raises(QueryError, match="outside"):
-        astar_cells(g, (0, 0), (2, 0))
+    # the robot radius is a keyword of plan(), not a parameter
+    with pytest.raises(ConfigError, match=r"^robot_radius_m: must be a finite number >= 0"):
+        pathfuse.plan(g, (0.5, 0.5), (1.5, 1.5), robot_radius_m=-1.0)
+    # cell-level A*: bad cells are query errors, a bad heuristic a config error
+    with pytest.raises(QueryError, match=r"goal cell \(0, 1\) is occupied"):
+        get_searcher(GridMap.from_rows([".#"])).search((0, 0), (0, 1))
+    with pytest.raises(QueryError, match=r"goal cell \(2, 0\) is outside the 2x2 grid"):
+        get_searcher(g).search((0, 0), (2, 0))
+    with pytest.raises(ConfigError, match=r"^heuristic: must be one of 'euclidean', 'octile', "
+                                          r"got 'manhattan'$"):
+        get_searcher(g).search((0, 0), (1, 1), heuristic="manhattan")
+    with pytest.raises(MapError, match="non-empty 2-D"):
+        AStarSearcher(np.zeros((0, 3), dtype=bool))
 
 
 def test_registry_entry():
     spec = get_planner("astar")
-    assert spec.func is plan_astar and spec.params_cls is AStarParams
-    assert spec.uses_astar and spec.description and callable(spec.warmup)
+    assert spec.controller is FollowController and spec.function is None
+    assert spec.params_cls is AStarParams and spec.global_planner == "astar"
+    assert spec.uses_astar and spec.offline and spec.online and spec.description
     assert spec.defaults() == {"heuristic": "euclidean", "corner_cutting": False}
+    warm(spec)
+    # the older name of the same planner
+    assert get_planner("astar-follow") is spec
+    r = pathfuse.plan(GridMap.from_rows(["..", ".."]), (0.5, 0.5), (1.5, 1.5),
+                      planner="astar-follow")
+    assert r.success and r.planner == "astar"
 
 
 def test_result_fields(den):
@@ -375,11 +404,14 @@ def test_searcher_cache_per_map_and_rule():
     assert get_searcher(g, corner_cutting=True) is not a
     with a.lock:  # busy (another thread): a fresh searcher is handed out
         b = get_searcher(g)
-        assert b is not a and b.search((0, 0), (4, 4)).status == "SUCCESS"
-    n = len(astar_mod._CACHE)
+        assert b is not a and b.search((0, 0), (4, 4)).status is Status.SUCCESS
+    assert g in astar_mod._CACHE
+    gone = weakref.ref(g)
     del g, a, b
     gc.collect()
-    assert len(astar_mod._CACHE) == n - 1
+    # the cache holds its map weakly: the map and its searchers went
+    assert gone() is None
+    assert all(k is not None for k in astar_mod._CACHE.keys())
 
 
 def test_query_time_scales_with_touched_cells_not_map_size():
@@ -390,7 +422,7 @@ def test_query_time_scales_with_touched_cells_not_map_size():
     for _ in range(200):
         r = s.search((1000, 1000), (1003, 1004))
     per_query = (time.perf_counter() - t) / 200
-    assert r.status == "SUCCESS" and r.expansions <= 8
+    assert r.status is Status.SUCCESS and r.expansions <= 8
     # clearing 4M-cell buffers per query would cost milliseconds; the stamps make it ~us
     assert per_query < 1e-3, per_query
 

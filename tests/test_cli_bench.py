@@ -27,7 +27,7 @@ PLUGIN = '''
 from dataclasses import dataclass
 import time
 import numpy as np
-from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.planners.registry import register_function
 from pathfuse.result import PlanResult, Status
 
 
@@ -48,7 +48,7 @@ def plan(grid, start, goal, params, budget):
                       time_s=time.perf_counter() - t0)
 
 
-register(PlannerSpec("segment", plan, Params, "straight segment (test plug-in)"))
+register_function("segment", plan, Params, "straight segment (test plug-in)")
 '''
 
 ROOM = """

@@ -47,7 +47,7 @@ def test_simulate_json_equals_the_library(tmp_path):
     for k in ("status", "planner", "params", "path_length_m", "time_to_goal_s",
               "min_distance_m", "n_ticks", "collision_with"):
         assert d[k] == ep[k], k
-    assert d["status"] == "REACHED" and "positions" not in d
+    assert d["status"] == "SUCCESS" and "positions" not in d
     full = json.loads(run("simulate", HEAD_ON, "--json", "--trajectories").stdout)
     assert len(full["positions"]) == full["n_ticks"] + 1
 
@@ -92,7 +92,7 @@ def test_dynamic_end_to_end(tmp_path):
         eps = list(csv.DictReader(fh))
     assert len(eps) == 12
     assert {(e["moving"], e["planner"]) for e in eps} == {
-        (m, pl) for m in ("0", "2") for pl in ("fusion", "astar-follow")}
+        (m, pl) for m in ("0", "2") for pl in ("fusion", "astar")}
     with open(out / "summary.csv", newline="") as fh:
         summ = list(csv.DictReader(fh))
     for r in summ:
@@ -100,7 +100,7 @@ def test_dynamic_end_to_end(tmp_path):
                                     "no_path"))
         assert n == int(r["episodes"]) == 3
         mine = [e for e in eps if (e["moving"], e["planner"]) == (r["moving"], r["planner"])]
-        assert int(r["reached"]) == sum(e["status"] == "REACHED" for e in mine)
+        assert int(r["reached"]) == sum(e["status"] == "SUCCESS" for e in mine)
 
 
 def _bad_scenario(tmp_path):
@@ -112,7 +112,7 @@ def _bad_scenario(tmp_path):
 @pytest.mark.parametrize("args,fragments", [
     (("simulate", "no-such-file.yaml"), ("simulate", "no-such-file.yaml")),
     (("simulate", "BAD"), ("robot.size", "unknown key")),
-    (("simulate", HEAD_ON, "--planner", "nope"), ("unknown online planner 'nope'",)),
+    (("simulate", HEAD_ON, "--planner", "nope"), ("unknown planner 'nope'",)),
     (("simulate", HEAD_ON, "--param", "kat=1"), ("kat", "unknown parameter")),
     (("simulate", HEAD_ON, "--seed", "-1"), ("--seed",)),
     (("simulate", HEAD_ON, "--fps", "0"), ("--fps",)),

@@ -1,25 +1,36 @@
-"""Every registered planner keeps the same contract.
+"""Every registered planner keeps the same contract, offline and online.
 
 The planners are taken from the registry, so a planner added later is checked
-here without editing this file: success and safety on the paper's maps,
-correct end points, the statuses of bad queries and exhausted budgets, unknown
-parameters, determinism, and the bookkeeping of :class:`PlanResult`.
+here without editing this file.  Offline (:func:`pathfuse.plan`): success and
+safety on the paper's maps, correct end points, the statuses of bad queries
+and exhausted budgets, the robot radius, unknown parameters, determinism, and
+the bookkeeping of :class:`PlanResult`.  Online (:func:`pathfuse.simulate`):
+reaching the goal on small static maps, the bookkeeping of an
+:class:`Episode` among a crossing disc, and one set of parameter defaults for
+both.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 import time
 
 import numpy as np
 import pytest
 
-from pathfuse import Budget, ConfigError, GridMap, Status, plan
+from pathfuse import Budget, ConfigError, GridMap, Status, plan, simulate
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
-from pathfuse.metrics import evaluate
-from pathfuse.planners.registry import get_planner, planner_names
+from pathfuse.metrics import collision_free, evaluate, path_length
+from pathfuse.planners.fusion import FusionParams
+from pathfuse.planners.global_astar import route
+from pathfuse.planners.registry import get_planner, make_params, planner_names
+from pathfuse.planners.run import warm
+from pathfuse.problem import Problem
 
 NAMES = planner_names()
+ONLINE = [n for n in NAMES if get_planner(n).online]
 SEEDS = range(10)
 
 BOX = GridMap.from_rows([   # the goal (5.5, 2.5) is walled in
@@ -40,8 +51,20 @@ def check_bookkeeping(r, name):
         assert r.length == pytest.approx(float(np.hypot(*np.diff(r.path, axis=0).T).sum()))
 
 
+def counts_expansions(name):
+    """Whether ``Budget.max_iterations`` caps the global search (grid A*) rather than the
+    controller's moves."""
+    ctrl = get_planner(name).controller
+    return ctrl is not None and ctrl.search_budget
+
+
 def test_all_builtin_planners_are_registered():
-    assert {"astar", "apf", "fusion", "ref6", "ref7"} <= set(NAMES)
+    assert {"astar", "astar-replan", "apf", "fusion", "ref6", "ref7"} <= set(NAMES)
+    # every built-in planner runs offline and online
+    for name in ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7"):
+        spec = get_planner(name)
+        assert spec.offline and spec.online and spec.capabilities() == ("offline", "online")
+    assert get_planner("astar-follow").name == "astar"
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -74,7 +97,8 @@ def test_end_points_off_cell_centres(name):
     s, e = (-0.8, 2.3), (4.6, 5.45)
     r = plan(g, s, e, planner=name)
     assert r.success and evaluate(g, r)["collision_free"]
-    if name == "astar":  # a grid path runs between cell centres
+    if "cells" in r.info:  # a grid path (astar, astar-replan) runs between cell centres
+        np.testing.assert_allclose(r.path, g.cell_to_world(r.info["cells"]))
         np.testing.assert_allclose(r.path[[0, -1]], [[-0.75, 2.25], [4.75, 5.25]])
     else:
         assert r.path[0].tolist() == list(s) and r.path[-1].tolist() == list(e)
@@ -95,10 +119,63 @@ def test_bad_queries(name, start, goal, status):
 
 
 @pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("start,goal,status", [
+    ((0.1, 0.5), (9.5, 4.5), Status.START_OCCUPIED),   # the disc overlaps the map's edge
+    ((0.5, 0.5), (9.5, 4.85), Status.GOAL_OCCUPIED),
+    ((2.75, 2.5), (9.5, 4.5), Status.START_OCCUPIED),  # the disc overlaps a square
+    ((0.5, 0.5), (8.25, 2.0), Status.GOAL_OCCUPIED),
+])
+def test_robot_disc_blocked_at_start_or_goal(name, start, goal, status):
+    r = plan(BOX, start, goal, planner=name, robot_radius_m=0.3)
+    assert r.status is status and r.planner == name and r.path.shape == (0, 2)
+    # the same points are free for a point robot
+    assert plan(BOX, start, goal, planner=name, robot_radius_m=0.0).status not in (
+        Status.START_OCCUPIED, Status.GOAL_OCCUPIED)
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("start,goal,blocked", [
+    ((0.3, 2.5), (9.5, 2.5), Status.START_OCCUPIED),
+    ((0.5, 2.5), (9.7, 2.5), Status.GOAL_OCCUPIED),
+    ((0.5, 2.5), (5.5, 4.7), Status.GOAL_OCCUPIED),
+])
+def test_robot_disc_touching_the_edge_is_either_blocked_or_planned(name, start, goal, blocked):
+    # the robot disc at the start or goal touches the map's edge (clearance exactly the
+    # radius): the one problem check decides, for every planner alike, whether the query
+    # is blocked; a query it accepts on this open map must be planned to the goal
+    g = GridMap(np.zeros((5, 10), dtype=bool))
+    r = plan(g, start, goal, planner=name, robot_radius_m=0.3)
+    accepted = Problem.create(g, start, goal, robot_radius_m=0.3).failure() is None
+    if not accepted:
+        assert r.status is blocked and r.path.shape == (0, 2)
+    else:
+        assert r.status is Status.SUCCESS, (name, r.message)
+        if "cells" not in r.info:
+            assert r.path[0].tolist() == list(start) and r.path[-1].tolist() == list(goal)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_robot_radius_keeps_clearance_from_squares_and_the_edge(name):
+    spec = get_planner(name)
+    radius = 0.3
+    for seed in range(4):
+        g = paper_map(seed)
+        r = plan(g, PAPER_START, PAPER_GOAL, planner=name, robot_radius_m=radius)
+        check_bookkeeping(r, name)
+        assert len(r.path) >= 2, (name, seed, r.message)
+        assert collision_free(g, r.path, robot_radius_m=radius), (name, seed)
+        x0, y0, x1, y1 = g.bounds
+        edge = np.min([r.path[:, 0] - x0, x1 - r.path[:, 0], r.path[:, 1] - y0,
+                       y1 - r.path[:, 1]])
+        assert edge >= radius, (name, seed)
+        if spec.uses_astar:
+            assert r.success, (name, seed, r.message)
+
+
+@pytest.mark.parametrize("name", NAMES)
 def test_unreachable_goal(name):
     spec = get_planner(name)
-    if spec.warmup is not None:  # keep a cold numba cache out of the wall-clock check
-        spec.warmup()
+    warm(spec)  # keep a cold numba cache out of the wall-clock check
     t0 = time.perf_counter()
     r = plan(BOX, (0.5, 0.5), (5.5, 2.5), planner=name)
     wall = time.perf_counter() - t0
@@ -119,14 +196,23 @@ def test_iteration_cap(name, cap):
     check_bookkeeping(r, name)
     assert r.status is Status.MAX_ITERATIONS
     # the cap counts expansions for grid A*, force steps for the potential-field planners
-    assert (r.expansions if name == "astar" else r.iterations) == cap
+    assert (r.expansions if counts_expansions(name) else r.iterations) == cap
     assert evaluate(CORRIDOR, r)["collision_free"]
 
 
 @pytest.mark.parametrize("name", NAMES)
 def test_unknown_parameter(name):
-    with pytest.raises(ConfigError, match="no_such_knob"):
+    spec = get_planner(name)
+    fields = ", ".join(spec.defaults())
+    want = (rf"^{re.escape(name)}\.no_such_knob: unknown parameter "
+            rf"\(parameters: {re.escape(fields)}\)$")
+    with pytest.raises(ConfigError, match=want):
         plan(CORRIDOR, (0.5, 2.5), (38.5, 2.5), planner=name, no_such_knob=1)
+    # the robot radius is part of the problem, never a planner parameter
+    assert "robot_radius_m" not in spec.defaults()
+    with pytest.raises(ConfigError, match=r"^robot_radius_m: must be a finite number >= 0, "
+                                          r"got -0\.5$"):
+        plan(CORRIDOR, (0.5, 2.5), (38.5, 2.5), planner=name, robot_radius_m=-0.5)
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -146,3 +232,137 @@ def test_deterministic(name):
     b = plan(g, PAPER_START, PAPER_GOAL, planner=name)
     assert a.status is b.status and np.array_equal(a.path, b.path)
     assert a.iterations == b.iterations and a.expansions == b.expansions
+
+
+# ============================================================================== online
+# Small static scenarios on which every planner - plain APF included - reaches the goal.
+REACHABLE = {
+    "corridor": {"map": {"rows": ["........", "........", "........"]},
+                 "start": [0.5, 1.5], "goal": [7.5, 1.5], "robot": {"radius": 0.2}},
+    "block": {"map": {"rows": ["..........", "..........", "....##....", "....##....",
+                               "..........", ".........."]},
+              "start": [0.5, 0.5], "goal": [9.5, 5.5], "robot": {"radius": 0.2}},
+    "offset": {"map": {"rows": ["............", "............", "......#.....", "......#.....",
+                                "............", "............"],
+                       "resolution": 0.5, "origin": [-1.0, 2.0]},
+               "start": [-0.7, 2.3], "goal": [4.6, 4.7], "robot": {"radius": 0.15}},
+}
+# A wall in front of the start: plain APF has a local minimum there, the others must pass.
+WALL = {"map": {"rows": ["..........", "..........", "...#......", "...#......", "...#......",
+                         ".........."]},
+        "start": [0.5, 3.5], "goal": [9.5, 3.5], "robot": {"radius": 0.2}}
+# One disc crossing the straight line from start to goal.
+CROSSING = {"map": {"rows": ["............"] * 5},
+            "start": [0.5, 2.5], "goal": [11.5, 2.5], "robot": {"radius": 0.2},
+            "time_limit": 30,
+            "obstacles": [{"position": [6.0, 0.5], "velocity": [0.0, 0.4], "radius": 0.3}]}
+
+
+def check_episode(ep, name, sc):
+    """The bookkeeping of an :class:`Episode`, whatever its outcome."""
+    spec = get_planner(name)
+    assert isinstance(ep.status, Status)
+    assert ep.planner == spec.name
+    assert ep.params == spec.defaults()
+    n, k = ep.n_ticks, len(sc.get("obstacles", []))
+    dt = ep.scenario.dt
+    assert ep.times.shape == (n + 1,) and ep.times[0] == 0.0
+    np.testing.assert_allclose(np.diff(ep.times), dt)
+    assert ep.positions.shape == (n + 1, 2) and np.all(np.isfinite(ep.positions))
+    assert ep.positions[0].tolist() == list(sc["start"])
+    assert ep.velocities.shape == (n, 2) and ep.plan_times_s.shape == (n,)
+    assert ep.obstacle_positions.shape == (n + 1, k, 2) and ep.sensed.shape == (n + 1, k)
+    assert ep.obstacle_radii.shape == (k,)
+    # the robot moved with the recorded (clipped) velocities
+    np.testing.assert_allclose(ep.positions[1:], ep.positions[:-1] + ep.velocities * dt,
+                               atol=1e-12)
+    speed = ep.scenario.robot.max_speed
+    assert np.all(np.hypot(*ep.velocities.T) <= speed * (1 + 1e-12))
+    assert ep.path_length_m == pytest.approx(path_length(ep.positions))
+    assert ep.min_distance_m == min(ep.min_static_clearance_m, ep.min_obstacle_distance_m)
+    assert (ep.min_obstacle_distance_m == math.inf) == (k == 0)
+    assert ep.reached == (ep.status is Status.SUCCESS)
+    if ep.status is Status.SUCCESS:
+        assert ep.time_to_goal_s == ep.times[-1] and n > 0
+        a, b, goal = ep.positions[-2], ep.positions[-1], np.array(sc["goal"])
+        t = np.clip(np.dot(goal - a, b - a) / max(np.dot(b - a, b - a), 1e-300), 0.0, 1.0)
+        assert np.hypot(*(a + t * (b - a) - goal)) <= ep.scenario.goal_tolerance + 1e-9
+    else:
+        assert ep.time_to_goal_s is None
+    if ep.status is Status.COLLISION:
+        assert ep.collision_with is not None and ep.min_distance_m < 0
+        if ep.collision_with == "static":
+            assert ep.min_static_clearance_m < 0
+        else:
+            assert 0 <= ep.collision_with < k and ep.min_obstacle_distance_m < 0
+    else:
+        assert ep.collision_with is None and ep.min_distance_m >= 0
+    if spec.uses_astar and ep.status not in (Status.NO_PATH, Status.START_OCCUPIED,
+                                             Status.GOAL_OCCUPIED):
+        # the first global path is the one plan() would follow on the static map
+        g = ep.scenario.grid
+        np.testing.assert_array_equal(
+            ep.global_path, route(g, sc["start"], sc["goal"], sc["robot"]["radius"]))
+        assert ep.path_updates[0][0] == 0
+    elif not spec.uses_astar:
+        assert ep.global_path is None and ep.path_updates == []
+    assert ep.message
+
+
+@pytest.mark.parametrize("name", ONLINE)
+@pytest.mark.parametrize("where", sorted(REACHABLE))
+def test_online_reaches_the_goal_on_static_maps(name, where):
+    sc = REACHABLE[where]
+    ep = simulate(sc, planner=name)
+    check_episode(ep, name, sc)
+    assert ep.status is Status.SUCCESS, (name, where, ep.message)
+    assert ep.min_static_clearance_m >= 0
+    # the same scenario and seed give the same episode, bit for bit
+    again = simulate(sc, planner=name)
+    assert again.status is ep.status and np.array_equal(again.positions, ep.positions)
+
+
+@pytest.mark.parametrize("name", ONLINE)
+def test_online_local_minimum_only_for_plain_apf(name):
+    ep = simulate(WALL, planner=name)
+    check_episode(ep, name, WALL)
+    assert ep.min_static_clearance_m >= 0
+    if get_planner(name).uses_astar:
+        assert ep.status is Status.SUCCESS, (name, ep.message)
+    else:
+        assert ep.status in (Status.SUCCESS, Status.LOCAL_MINIMUM), (name, ep.message)
+
+
+@pytest.mark.parametrize("name", ONLINE)
+def test_online_crossing_disc_bookkeeping(name):
+    ep = simulate(CROSSING, planner=name)
+    check_episode(ep, name, CROSSING)
+    assert ep.status in set(Status)
+    assert ep.status in (Status.SUCCESS, Status.COLLISION, Status.TIMEOUT,
+                         Status.LOCAL_MINIMUM), (name, ep.message)
+    # whatever happened with the disc, the robot never touched the static map
+    assert ep.min_static_clearance_m >= 0 or ep.collision_with == "static"
+    assert ep.sensed.any()   # the disc came within the sensing radius
+
+
+def test_plan_and_simulate_use_the_same_fusion_defaults():
+    spec = get_planner("fusion")
+    assert spec.params_cls is FusionParams
+    defaults = dataclasses.asdict(FusionParams())
+    assert spec.params_cls() == FusionParams() and spec.defaults() == defaults
+    # what plan() builds without parameters, and what simulate() records
+    assert make_params(spec) == FusionParams()
+    ep = simulate(REACHABLE["corridor"], planner="fusion")
+    assert ep.params == defaults
+    assert simulate(REACHABLE["corridor"]).params == defaults   # the default planner
+    # one override, the other defaults kept, offline and online alike
+    ep = simulate(REACHABLE["corridor"], planner={"name": "fusion", "params": {"r1_m": 1.5}})
+    assert ep.params == {**defaults, "r1_m": 1.5}
+    assert make_params(spec, {"r1_m": 1.5}) == FusionParams(r1_m=1.5)
+
+
+@pytest.mark.parametrize("name", ONLINE)
+def test_plan_and_simulate_use_the_same_defaults(name):
+    spec = get_planner(name)
+    ep = simulate(REACHABLE["corridor"], planner=name)
+    assert ep.params == dataclasses.asdict(make_params(spec)) == spec.defaults()

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from pathfuse.bench.experiment import canonical_json, load_experiment, parse_experiment
-from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.planners.registry import register_function
 from pathfuse.result import ConfigError, PlanResult, Status
 
 
@@ -37,8 +37,8 @@ def _never(grid, start, goal, params, budget):  # experiments are only expanded 
 # (registered for each test; conftest.py restores the registry afterwards)
 @pytest.fixture(autouse=True)
 def _test_planners():
-    register(PlannerSpec("xsweep", _never, _Params, "test planner for experiment parsing"))
-    register(PlannerSpec("xother", _never, _Params, "second test planner"))
+    register_function("xsweep", _never, _Params, "test planner for experiment parsing")
+    register_function("xother", _never, _Params, "second test planner")
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared" / "data" / "movingai"
@@ -193,8 +193,6 @@ planners: [xsweep]
 
 
 def test_random_queries_and_dynamic_entries(tmp_path):
-    online = pytest.importorskip("pathfuse.world.online")
-    online.register_online(online.OnlinePlannerSpec("xonline", lambda p: None, _Params, "test"))
     (tmp_path / "sc.yaml").write_text('map: {rows: ["......"]}\nstart: [0.5, 0.5]\n'
                                       'goal: [5.5, 0.5]\nrobot: {radius: 0.2}\n')
     (tmp_path / "bad.yaml").write_text("anything: 1\n")
@@ -208,20 +206,21 @@ maps:
     dynamic: sc.yaml
 planners: %s
 """
+    # xsweep is an offline-only plug-in function: it cannot drive a dynamic entry
     with pytest.raises(ConfigError, match=r"maps\[1\]: no planner of this experiment runs "
-                                          r"dynamic maps \(online planners"):
+                                          r"dynamic maps \(planners that run online: astar, "):
         load_experiment(write(tmp_path, text % "[xsweep]"))
     with pytest.raises(ConfigError, match=r"planners\[1\].name: unknown planner 'nope' "
                                           r"\(choose from static: .*; dynamic: "):
         load_experiment(write(tmp_path, text % "[xsweep, nope]"))
     with pytest.raises(ConfigError, match=r"maps\[1\].dynamic: .*bad.yaml: anything: unknown"):
         load_experiment(write(tmp_path, text.replace("sc.yaml", "bad.yaml")
-                              % "[xsweep, xonline]"))
+                              % "[xsweep, {name: fusion, kinds: [dynamic]}]"))
     gen = "  - name: gen\n    dynamic: {generate: {moving: 2, bogus: 1}}\n"
     with pytest.raises(ConfigError, match=r"maps\[2\].dynamic.generate.bogus: unknown argument"):
         load_experiment(write(tmp_path, text.replace("planners:", gen + "planners:")
-                              % "[xsweep, xonline]"))
-    exp = load_experiment(write(tmp_path, text % "[xsweep, xonline]"))
+                              % "[xsweep, {name: fusion, kinds: [dynamic]}]"))
+    exp = load_experiment(write(tmp_path, text % "[xsweep, {name: fusion, kinds: [dynamic]}]"))
     assert [p.kinds for p in exp.planners] == [("static",), ("dynamic",)]
     runs = exp.expand()
     assert {r.planner for r in runs if r.kind == "static"} == {"xsweep"}

@@ -1,4 +1,4 @@
-"""Forces of eq. 3-6 and the grid pieces of the stepping kernel."""
+"""Forces of eq. 3-6 and the grid pieces of the stepping kernels (repulsion, geometry, motion)."""
 
 from __future__ import annotations
 
@@ -19,14 +19,9 @@ from pathfuse.field.forces import (
     repulsive_potential,
     total_force,
 )
-from pathfuse.field.stepper import (
-    HOW_BLOCKED,
-    MARGIN_FRAC,
-    apf_force,
-    grid_repulsion,
-    safe_step,
-    segment_is_clear,
-)
+from pathfuse.field.motion import HOW_BLOCKED, MARGIN_FRAC, safe_step
+from pathfuse.field.repulsion import apf_force, grid_repulsion
+from pathfuse.geometry import segment_box_distance, segment_is_clear
 from pathfuse.grid import GridMap
 from pathfuse.metrics import in_bounds, min_clearance
 
@@ -184,6 +179,23 @@ def test_segment_clear_cases():
     # a robot of radius 0.3 fits at (0.5, 1.5) but not 0.2 from the square's edge
     assert segment_is_clear(0.5, 1.5, 0.55, 1.5, occ, ox, oy, res, 0.3 + c)
     assert not segment_is_clear(0.5, 1.5, 0.5, 1.2, occ, ox, oy, res, 0.3 + c)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.floats(-3, 3), st.floats(-3, 3), st.floats(-3, 3), st.floats(-3, 3),
+       st.floats(-1, 1), st.floats(-1, 1), st.floats(0.01, 2), st.floats(0.01, 2))
+def test_segment_box_distance_matches_sampling(ax, ay, bx, by, x0, y0, w, h):
+    x1, y1 = x0 + w, y0 + h
+    d = segment_box_distance(ax, ay, bx, by, x0, y0, x1, y1)
+    t = np.linspace(0.0, 1.0, 4001)
+    px, py = ax + t * (bx - ax), ay + t * (by - ay)
+    dx = np.maximum(np.maximum(x0 - px, 0.0), px - x1)
+    dy = np.maximum(np.maximum(y0 - py, 0.0), py - y1)
+    sampled = float(np.hypot(dx, dy).min())
+    # exact distance <= any sample; samples 1/4000 of the segment apart are within half a gap
+    assert d <= sampled + 1e-12
+    assert sampled - d <= 0.5 * math.hypot(bx - ax, by - ay) / 4000 + 1e-12
+    assert d >= 0.0
 
 
 @settings(max_examples=400, deadline=None)

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 from collections import defaultdict
 
 import numpy as np
@@ -14,8 +16,9 @@ from pathfuse import Budget, ConfigError, GridMap, Status, plan
 from pathfuse.field.forces import attractive_force, total_force
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate, path_length, r_ratio
-from pathfuse.planners.fusion import FusionParams, follow_global_path, force_at
+from pathfuse.planners.fusion import FusionController, FusionParams, follow_path, force_at
 from pathfuse.planners.registry import get_planner
+from pathfuse.planners.run import warm
 
 START, GOAL = np.array(PAPER_START), np.array(PAPER_GOAL)
 
@@ -90,8 +93,11 @@ def count_shortest_paths(grid: GridMap, start, goal) -> int:
 def test_registered():
     spec = get_planner("fusion")
     assert spec.params_cls is FusionParams and spec.uses_astar
-    assert spec.description and callable(spec.warmup)
-    spec.warmup()
+    assert spec.global_planner == "astar" and spec.controller is FusionController
+    assert spec.offline and spec.online and spec.description
+    assert callable(spec.controller.warmup)
+    warm(spec)
+    assert "robot_radius_m" not in spec.defaults()
 
 
 def test_paper_maps_success_and_safety():
@@ -111,11 +117,9 @@ def test_paper_maps_success_and_safety():
 
 
 def test_info_holds_the_astar_run():
-    from pathfuse.planners.astar import AStarParams, plan_astar
-
     g = paper_map(11)
     r = plan(g, PAPER_START, PAPER_GOAL, planner="fusion")
-    a = plan_astar(g, START, GOAL, AStarParams(), Budget())
+    a = plan(g, PAPER_START, PAPER_GOAL, planner="astar")
     np.testing.assert_array_equal(r.info["astar_path"], a.path)
     assert r.info["astar_length"] == pytest.approx(path_length(a.path))
     assert 0 < r.info["astar_time_s"] < r.time_s
@@ -260,17 +264,16 @@ def test_escape_off_is_the_paper_algorithm_and_stops_at_the_first_stall():
 @pytest.mark.parametrize("seed", range(12))
 def test_step2_is_direction_free(seed):
     # the same global path, rotated with the map: the same walk, rotated
-    from pathfuse.planners.astar import AStarParams, plan_astar
-
     g = paper_map(seed)
-    a = plan_astar(g, START, GOAL, AStarParams(), Budget())
-    base = follow_global_path(g, START, GOAL, a.path)
+    a = plan(g, PAPER_START, PAPER_GOAL, planner="astar")
+    base = follow_path(g, START, GOAL, a.path)
+    assert base.path[0].tolist() == list(PAPER_START) and collision_free(g, base.path)
     for turns, mirror in TRANSFORMS:
         tg, tp = transform(g, turns, mirror)
-        r = follow_global_path(tg, tp(START), tp(GOAL), tp(a.path))
+        r = follow_path(tg, tp(START), tp(GOAL), tp(a.path))
         assert r.status is base.status
         assert r.info["escapes"] == base.info["escapes"]
-        assert r.length == pytest.approx(base.length, rel=1e-9)
+        assert path_length(r.path) == pytest.approx(path_length(base.path), rel=1e-9)
         np.testing.assert_allclose(r.path, tp(base.path), atol=1e-7)
 
 
@@ -307,12 +310,29 @@ def test_direction_free_default_works_for_any_direction():
     {"escape_points": 0}, {"k_att": float("inf")}, {"rho0_m": -2.0}, {"step_m": -0.1},
 ])
 def test_bad_params_name_the_value(bad):
-    (key, _), = bad.items()
-    with pytest.raises(ConfigError, match=key):
+    (key, value), = bad.items()
+    want = rf"^fusion\.{key}: must be .+, got {re.escape(repr(value))}$"
+    with pytest.raises(ConfigError, match=want):
         plan(paper_map(0), PAPER_START, PAPER_GOAL, planner="fusion", **bad)
+
+
+def test_error_messages_of_the_docs():
+    with pytest.raises(ConfigError) as e:
+        plan(paper_map(0), PAPER_START, PAPER_GOAL, planner="fusion", ahead="behind")
+    assert str(e.value) == "fusion.ahead: must be one of 'progress', 'paper-x', got 'behind'"
+    with pytest.raises(ConfigError, match=r"^fusion\.no_such_knob: unknown parameter "
+                                          r"\(parameters: .*\br1_m\b.*\)$"):
+        plan(paper_map(0), PAPER_START, PAPER_GOAL, planner="fusion", no_such_knob=1)
+    # the robot radius is a keyword of plan(), not a parameter of the planner
+    with pytest.raises(TypeError):
+        FusionParams(robot_radius_m=0.3)
 
 
 def test_defaults_documented_values():
     p = FusionParams()
     assert (p.k_att, p.k_rep, p.rho0_m) == (40.0, 5.0, 2.0)
     assert p.r1_m == p.r2_m == p.rho0_m and p.ahead == "progress" and p.escape
+    # one set of defaults offline and online (the old online r1 1.5 / escape_points 6 are gone)
+    assert p.escape_points == 3 and p.stall_steps == 40 and p.heuristic == "euclidean"
+    assert p.step_m is None and p.goal_tolerance_m is None and p.stall_distance_m is None
+    assert get_planner("fusion").defaults() == dataclasses.asdict(p)

@@ -105,6 +105,48 @@ def test_inflate_rejects_negative_radius():
         GridMap(np.zeros((2, 2), bool)).inflate(-1)
 
 
+def _cspace_oracle(occ, res, r):
+    """Brute force: a cell is blocked when its centre is closer than r to an occupied
+    square or to the outside of the map."""
+    out = _square_distance_oracle(occ, res, r)
+    h, w = occ.shape
+    for i in range(h):
+        for j in range(w):
+            edge = min(j + 0.5, w - j - 0.5, i + 0.5, h - i - 0.5) * res
+            if edge < r:
+                out[i, j] = True
+    return out
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    occ=st.lists(st.lists(st.booleans(), min_size=7, max_size=7), min_size=6, max_size=6),
+    res=st.sampled_from([0.05, 0.5, 1.0]),
+    r_cells=st.floats(0.0, 3.0),
+    origin=st.tuples(st.floats(-20, 20), st.floats(-20, 20)),
+)
+def test_cspace_matches_brute_force(occ, res, r_cells, origin):
+    occ = np.array(occ, bool)
+    g = GridMap(occ, resolution=res, origin=origin)
+    cs = g.cspace(r_cells * res)
+    assert cs.shape == g.shape and cs.resolution == g.resolution and cs.origin == g.origin
+    assert np.array_equal(cs.occupied, _cspace_oracle(occ, res, r_cells * res))
+
+
+def test_cspace_grows_the_map_edge_and_is_cached():
+    g = GridMap.from_rows([".....", ".....", "....."], resolution=0.5)
+    assert g.cspace(0) is g and g.cspace(0.0) is g
+    cs = g.cspace(0.3)   # edge cell centres are 0.25 m in
+    assert cs.occupied.astype(int).tolist() == [[1, 1, 1, 1, 1], [1, 0, 0, 0, 1],
+                                                [1, 1, 1, 1, 1]]
+    assert g.cspace(0.3) is cs
+    assert not g.cspace(0.25).occupied.any()   # touching the edge is allowed
+    assert not g.inflate(0.3).occupied.any()   # inflate grows obstacles only
+    for bad in (-0.1, float("nan"), float("inf")):
+        with pytest.raises(MapError, match="radius"):
+            g.cspace(bad)
+
+
 def test_distance_field_is_metric_and_cached():
     occ = np.zeros((5, 7), bool)
     occ[2, 3] = True

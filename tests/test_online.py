@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import inspect
 import json
 import math
 
@@ -9,22 +11,34 @@ import numpy as np
 import pytest
 
 import pathfuse
-from pathfuse import ConfigError, GridMap
+from pathfuse import ConfigError, GridMap, Status
 from pathfuse.field.forces import repulsive_force
+from pathfuse.field.repulsion import disc_repulsion
+from pathfuse.planners.apf import APFParams
+from pathfuse.planners.astar import ReplanParams
+from pathfuse.planners.base import Controller
+from pathfuse.planners.global_astar import route
+from pathfuse.planners.registry import (
+    PlannerSpec,
+    get_planner,
+    make_params,
+    planner_names,
+    register,
+    register_function,
+)
+from pathfuse.planners.run import start_online
+from pathfuse.problem import Problem
 from pathfuse.world import (
-    EpisodeStatus,
     Observation,
-    OnlinePlanner,
-    PlannerContext,
+    ScenarioError,
+    World,
     load_scenario,
-    online_planner_names,
     run_episode,
     simulate,
 )
 from pathfuse.world.generate import generate_scenarios
-from pathfuse.world.online import AStarReplan, disc_repulsion, robot_cspace
 
-PLANNERS = ["fusion", "apf", "astar-follow", "astar-replan", "ref6", "ref7"]
+PLANNERS = ["fusion", "apf", "astar", "astar-replan", "ref6", "ref7"]
 HALL = ["." * 15] * 5
 
 
@@ -73,10 +87,31 @@ def _independent_min_gaps(ep):
     return disc, static - r
 
 
+def _drive(doc, planner, params=None, seed=None):
+    """An episode driven by hand through the public API (World + start_online + act);
+    returns the controller and the robot's positions.  There is no stall test: compare
+    with episodes that end at the goal, in a collision or at the time limit."""
+    sc = load_scenario(doc)
+    spec = get_planner(planner)
+    world = World(sc)
+    obs = world.reset(seed)
+    ctrl = start_online(spec, Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius),
+                        make_params(spec, params), sc.dt, sc.robot.max_speed)
+    positions = [obs.position]
+    while ctrl.failure is None:
+        obs, term, trunc, _ = world.step(ctrl.act(obs))
+        positions.append(obs.position)
+        if term or trunc:
+            break
+    return ctrl, np.array(positions)
+
+
 # ----------------------------------------------------------------------------- registry
 def test_registry_names_and_parameter_errors():
-    assert sorted(online_planner_names()) == sorted(PLANNERS)
-    with pytest.raises(ConfigError, match="unknown online planner 'dstar'"):
+    # one registry: every built-in planner runs online
+    assert sorted(n for n in planner_names() if get_planner(n).online) == sorted(PLANNERS)
+    assert all(get_planner(n).offline for n in PLANNERS)
+    with pytest.raises(ConfigError, match=r"^planner.name: unknown planner 'dstar'"):
         simulate(head_on(), planner="dstar")
     with pytest.raises(ConfigError, match=r"^planner.params.swerve: must be a number >= 0"):
         simulate(head_on(), planner={"name": "fusion", "params": {"swerve": -1}})
@@ -84,6 +119,33 @@ def test_registry_names_and_parameter_errors():
         simulate(head_on(), planner={"name": "astar-replan", "params": {"replan_period_s": 0}})
     with pytest.raises(ConfigError, match=r"^planner.extra: unknown key"):
         simulate(head_on(), planner={"name": "apf", "extra": 1})
+    # parameters that no longer exist are unknown, naming the key
+    with pytest.raises(ConfigError, match=r"^planner.params.escape_ticks: unknown parameter"):
+        simulate(head_on(), planner={"name": "fusion", "params": {"escape_ticks": 20}})
+    with pytest.raises(ConfigError, match=r"^planner.params.robot_radius_m: unknown parameter"):
+        simulate(head_on(), planner={"name": "apf", "params": {"robot_radius_m": 0.2}})
+
+
+def test_the_old_astar_follow_name_runs_astar_and_the_episode_records_astar():
+    assert get_planner("astar-follow") is get_planner("astar")
+    old = simulate(head_on(), planner="astar-follow")
+    new = simulate(head_on(), planner="astar")
+    assert old.planner == new.planner == "astar"
+    assert np.array_equal(old.positions, new.positions)
+    assert old.to_dict()["planner"] == "astar"
+
+
+def test_an_offline_only_plugin_cannot_be_simulated():
+    def straight(grid, start, goal, params, budget):  # pragma: no cover - never called
+        raise AssertionError("an offline plug-in must not be run online")
+
+    spec = register_function("straight", straight, APFParams, "a straight line")
+    assert spec.offline and not spec.online
+    with pytest.raises(ScenarioError, match=r"^planner.name: 'straight' only plans offline"):
+        simulate(head_on(), planner="straight")
+    problem = Problem.create(GridMap.from_rows(HALL), (1.5, 2.5), (13.5, 2.5), 0.2)
+    with pytest.raises(ConfigError, match="only plans offline"):
+        start_online(spec, problem, APFParams(), 0.1, 1.0)
 
 
 def test_pathfuse_exports_simulate():
@@ -100,7 +162,7 @@ def test_every_planner_reaches_the_goal_without_moving_obstacles(planner, rows):
     doc = {"map": {"rows": rows}, "start": [1.5, 2.5], "goal": [10.5, 2.5],
            "robot": {"radius": 0.25}}
     ep = simulate(doc, planner=planner)
-    assert ep.status is EpisodeStatus.REACHED, ep.message
+    assert ep.status is Status.SUCCESS, ep.message
     assert np.hypot(*(ep.positions[-1] - [10.5, 2.5])) <= 0.25 + 1e-9
     disc, static = _independent_min_gaps(ep)
     assert static >= 0.0
@@ -110,14 +172,14 @@ def test_every_planner_reaches_the_goal_without_moving_obstacles(planner, rows):
 
 
 # ----------------------------------------------------------------------------- the head-on case
-def test_head_on_astar_follow_collides_and_fusion_passes():
-    follow = simulate(head_on(), planner="astar-follow")
-    assert follow.status is EpisodeStatus.COLLISION and follow.collision_with == 0
+def test_head_on_astar_collides_and_fusion_passes():
+    follow = simulate(head_on(), planner="astar")
+    assert follow.status is Status.COLLISION and follow.collision_with == 0
     disc, _ = _independent_min_gaps(follow)
     assert disc < 0.0                     # an independent look at the trajectories agrees
 
     fusion = simulate(head_on(), planner="fusion")
-    assert fusion.status is EpisodeStatus.REACHED, fusion.message
+    assert fusion.status is Status.SUCCESS, fusion.message
     disc, static = _independent_min_gaps(fusion)
     assert disc > 0.0 and static >= 0.0
     assert fusion.min_obstacle_distance_m == pytest.approx(disc, abs=1e-3)
@@ -131,14 +193,14 @@ def test_head_on_pure_radial_repulsion_cannot_pass():
     # only back off, pushed by the disc until it is pinned against the wall behind it
     ep = simulate(head_on(), planner={"name": "fusion",
                                       "params": {"swerve": 0.0, "dodge": False}})
-    assert ep.status is EpisodeStatus.COLLISION
+    assert ep.status is Status.COLLISION
     assert np.abs(ep.positions[:, 1] - 2.5).max() < 1e-9
 
 
 @pytest.mark.parametrize("planner", ["astar-replan", "apf", "ref6", "ref7"])
 def test_head_on_other_planners_avoid_the_disc(planner):
     ep = simulate(head_on(), planner=planner)
-    assert ep.status is EpisodeStatus.REACHED, ep.message
+    assert ep.status is Status.SUCCESS, ep.message
     assert _independent_min_gaps(ep)[0] > 0.0
 
 
@@ -181,6 +243,10 @@ def test_episode_record_is_consistent_and_json_ready():
     assert ep.path_length_m == pytest.approx(np.hypot(*np.diff(ep.positions, axis=0).T).sum())
     assert ep.positions[0].tolist() == [1.0, 1.0]
     assert ep.global_path is not None and ep.global_path[0].tolist() == [1.0, 1.0]
+    # the global path is the waypoints of A* on the robot's c-space (global_astar.route)
+    sc = ep.scenario
+    assert np.array_equal(ep.global_path, route(sc.grid, sc.start, sc.goal, sc.robot.radius))
+    assert ep.path_updates[0][0] == 0 and ep.path_updates[0][1] is ep.global_path
     if ep.reached:
         assert ep.time_to_goal_s == pytest.approx(ep.times[-1])
     # the sensing mask matches the sensing radius at every tick
@@ -201,44 +267,79 @@ def test_min_distance_matches_an_independent_computation():
         assert ep.min_obstacle_distance_m <= disc + 1e-12
         assert ep.min_obstacle_distance_m == pytest.approx(disc, abs=5e-3)
         assert ep.min_static_clearance_m == pytest.approx(min(static, 2.0), abs=5e-3)
-        assert (ep.status is EpisodeStatus.COLLISION) == (min(disc, static) < -1e-9)
+        assert (ep.status is Status.COLLISION) == (min(disc, static) < -1e-9)
 
 
 # ----------------------------------------------------------------------------- statuses
 def test_no_path_for_path_planners_and_a_stall_for_apf():
     rows = ["....#....", "....#....", "....#...."]
     doc = {"map": {"rows": rows}, "start": [0.5, 1.5], "goal": [8.5, 1.5], "time_limit": 20}
-    for planner in ["fusion", "astar-follow", "astar-replan", "ref6", "ref7"]:
+    for planner in ["fusion", "astar", "astar-replan", "ref6", "ref7"]:
         ep = simulate(doc, planner=planner)
-        assert ep.status is EpisodeStatus.NO_PATH and ep.n_ticks == 0
+        assert ep.status is Status.NO_PATH and ep.n_ticks == 0
     ep = simulate(doc, planner="apf")
-    assert ep.status is EpisodeStatus.LOCAL_MINIMUM
+    assert ep.status is Status.LOCAL_MINIMUM
     assert ep.times[-1] >= 10.0                       # the default stall_time
     ep = simulate({**doc, "stall_time": 0}, planner="apf")
-    assert ep.status is EpisodeStatus.TIMEOUT and ep.n_ticks == 200
+    assert ep.status is Status.TIMEOUT and ep.n_ticks == 200
+
+
+U_TRAP = ["...........",
+          "....###....",
+          "......#....",
+          "......#....",
+          "......#....",
+          "....###....",
+          "..........."]
 
 
 def test_apf_in_a_u_trap_is_a_local_minimum_and_fusion_is_not():
-    rows = ["...........",
-            "....###....",
-            "......#....",
-            "......#....",
-            "......#....",
-            "....###....",
-            "..........."]
-    doc = {"map": {"rows": rows}, "start": [1.5, 3.5], "goal": [9.5, 3.5]}
-    assert simulate(doc, planner="apf").status is EpisodeStatus.LOCAL_MINIMUM
-    assert simulate(doc, planner="fusion").status is EpisodeStatus.REACHED
+    doc = {"map": {"rows": U_TRAP}, "start": [1.5, 3.5], "goal": [9.5, 3.5]}
+    assert simulate(doc, planner="apf").status is Status.LOCAL_MINIMUM
+    ep = simulate(doc, planner="fusion")
+    assert ep.status is Status.SUCCESS, ep.message
+    assert _independent_min_gaps(ep)[1] >= 0.0
+    # it is the escape that gets it out: it escaped (driving back along its own trail, every
+    # move within the speed limit) and without the escape Algorithm 2 stalls in the trap
+    ctrl, positions = _drive(doc, "fusion")
+    assert np.array_equal(positions, ep.positions) and ctrl.escapes >= 1
+    assert np.hypot(*np.diff(positions, axis=0).T).max() <= 1.0 * 0.1 + 1e-9
+    paper = simulate(doc, planner={"name": "fusion", "params": {"escape": False}})
+    assert paper.status is Status.LOCAL_MINIMUM
+
+
+@pytest.mark.parametrize("turn", ["mirrored", "rot90", "rot270"])
+def test_fusion_escapes_the_u_trap_whichever_way_it_faces(turn):
+    # the escape drives back along the robot's trail, whatever the direction of travel
+    occ = np.array([[c == "#" for c in row] for row in U_TRAP])
+    mark = np.zeros(occ.shape, dtype=int)
+    mark[3, 1], mark[3, 9] = 1, 2                       # start and goal cells (row from the top)
+    f = {"mirrored": np.fliplr, "rot90": np.rot90, "rot270": lambda a: np.rot90(a, 3)}[turn]
+    occ, mark = f(occ), f(mark)
+    h = occ.shape[0]
+    (rs, cs), (rg, cg) = np.argwhere(mark == 1)[0], np.argwhere(mark == 2)[0]
+    doc = {"map": {"rows": ["".join("#" if v else "." for v in row) for row in occ]},
+           "start": [cs + 0.5, h - 0.5 - rs], "goal": [cg + 0.5, h - 0.5 - rg]}
+    ep = simulate(doc, planner="fusion")
+    assert ep.status is Status.SUCCESS, ep.message
+    ctrl, _ = _drive(doc, "fusion")
+    assert ctrl.escapes >= 1
+    assert simulate(doc, planner={"name": "fusion", "params": {"escape": False}}).status \
+        is Status.LOCAL_MINIMUM
 
 
 # ----------------------------------------------------------------------------- astar-replan
 def test_astar_replan_replans_at_its_rate_and_goes_around_a_standing_disc():
     doc = head_on(obstacles=[{"position": [7.5, 2.5], "velocity": [0, 0], "radius": 0.6}])
-    assert simulate(doc, planner="astar-follow").status is EpisodeStatus.COLLISION
-    planner = AStarReplan(pathfuse.world.online.AStarReplanParams(replan_period_s=0.5))
-    ep = run_episode(load_scenario(doc), planner)
-    assert ep.status is EpisodeStatus.REACHED
-    assert planner.replans == math.ceil(ep.n_ticks / 5)
+    assert simulate(doc, planner="astar").status is Status.COLLISION
+    params = ReplanParams(replan_period_s=0.5)
+    ep = run_episode(load_scenario(doc), "astar-replan", params)
+    assert ep.status is Status.SUCCESS
+    assert ep.planner == "astar-replan" and ep.params == dataclasses.asdict(params)
+    # the same controller driven by hand: the same walk, and a replan every 5 ticks
+    ctrl, positions = _drive(doc, "astar-replan", {"replan_period_s": 0.5})
+    assert np.array_equal(positions, ep.positions)
+    assert ctrl.replans == math.ceil(ep.n_ticks / 5) and ctrl.failed_replans == 0
     assert len(ep.path_updates) > 1 and ep.path_updates[0][0] == 0
     assert all(tick % 5 == 0 for tick, _ in ep.path_updates[1:])
     disc, static = _independent_min_gaps(ep)
@@ -246,12 +347,19 @@ def test_astar_replan_replans_at_its_rate_and_goes_around_a_standing_disc():
 
 
 # ----------------------------------------------------------------------------- what planners see
-class _Spy(OnlinePlanner):
-    name = "spy"
+@dataclasses.dataclass(frozen=True)
+class _SpyParams:
+    pass
 
-    def reset(self, ctx):
-        super().reset(ctx)
+
+class _Spy(Controller):
+    name = "spy"
+    made: list[_Spy] = []
+
+    def __init__(self, problem, params, plan=None, *, dt=None, max_speed=None):
+        super().__init__(problem, params, plan, dt=dt, max_speed=max_speed)
         self.seen = []
+        _Spy.made.append(self)
 
     def act(self, obs):
         self.seen.append(obs)
@@ -260,10 +368,22 @@ class _Spy(OnlinePlanner):
 
 def test_planners_get_the_static_context_and_current_observations_only():
     sc = load_scenario(_walkers())
-    spy = _Spy(None)
-    ep = run_episode(sc, spy, seed=3)
-    assert {f for f in PlannerContext.__dataclass_fields__} == \
-        {"grid", "start", "goal", "robot", "dt", "goal_tolerance"}
+    register(PlannerSpec("spy", _SpyParams, "records what it sees", controller=_Spy))
+    _Spy.made.clear()
+    ep = run_episode(sc, "spy", seed=3)
+    assert ep.planner == "spy" and len(_Spy.made) == 1
+    spy = _Spy.made[0]
+    # before the first tick a controller knows the static problem, the tick and the speed
+    # limit - never the moving discs
+    assert set(inspect.signature(Controller.__init__).parameters) == \
+        {"self", "problem", "params", "plan", "dt", "max_speed"}
+    assert {f.name for f in dataclasses.fields(Problem)} == \
+        {"grid", "start", "goal", "robot_radius_m", "budget", "start_cell", "goal_cell"}
+    pb = spy.problem
+    assert pb.grid is sc.grid and pb.start == sc.start and pb.goal == sc.goal
+    assert pb.robot_radius_m == sc.robot.radius
+    assert (spy.dt, spy.max_speed, spy.online, spy.plan) == (sc.dt, sc.robot.max_speed, True,
+                                                             None)
     assert all(isinstance(o, Observation) for o in spy.seen)
     assert [o.tick for o in spy.seen] == list(range(ep.n_ticks))
     for o in spy.seen:
@@ -334,7 +454,7 @@ def test_cspace_cell_centre_paths_keep_the_disc_clear(seed):
     res = [0.05, 0.1, 0.5, 1.0][seed]
     g = GridMap(rng.random((14, 14)) < 0.12, resolution=res, origin=(0.3, -1.1))
     for r in rng.uniform(0.01, 3.0, 5) * res:
-        occ = robot_cspace(g, r).occupied
+        occ = g.cspace(r).occupied
         free = np.argwhere(~occ)
         for rr, cc in free[rng.choice(len(free), size=min(40, len(free)), replace=False)]:
             for dr, dc in [(0, 1), (1, 0), (1, 1), (1, -1)]:

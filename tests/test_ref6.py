@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -11,17 +12,18 @@ from hypothesis import strategies as st
 
 from pathfuse import Budget, ConfigError, GridMap, Status, plan
 from pathfuse.field.forces import repulsive_force
+from pathfuse.field.repulsion import grid_improved_repulsion
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate
-from pathfuse.planners.ref6 import (
+from pathfuse.planners.refs import (
+    Ref6Controller,
     Ref6Params,
-    follow_subgoals,
-    grid_improved_repulsion,
     improved_repulsive_force,
     improved_repulsive_potential,
     inflection_points,
 )
 from pathfuse.planners.registry import get_planner
+from pathfuse.problem import Problem
 
 START, GOAL = np.array(PAPER_START), np.array(PAPER_GOAL)
 
@@ -56,9 +58,29 @@ def first_visit(path: np.ndarray, point, tol: float) -> int:
     return int(hits[0]) if hits.size else -1
 
 
+class GivenPath:
+    """A stand-in global plan: the controller reads only its waypoints."""
+
+    def __init__(self, waypoints):
+        self.waypoints = np.asarray(waypoints, dtype=np.float64)
+
+
+def follow_subgoals(g, start, goal, subgoals, params):
+    """Step 2 of ref6 alone: the improved APF through ``subgoals`` then the goal.
+
+    The controller takes the inflection points of its global path as sub-goals, so a
+    path start -> sub-goals -> goal whose every interior point is a turn gives exactly
+    ``subgoals``."""
+    wp = np.concatenate([[start], subgoals, [goal]])
+    assert inflection_points(wp).tolist() == np.asarray(subgoals, dtype=float).tolist()
+    return Ref6Controller(Problem.create(g, start, goal), params, GivenPath(wp)).run(None)
+
+
 def test_registered():
     spec = get_planner("ref6")
     assert spec.uses_astar and spec.params_cls is Ref6Params
+    assert spec.controller is Ref6Controller and spec.offline and spec.online
+    assert "robot_radius_m" not in spec.defaults()
     p = Ref6Params()
     assert (p.k_att, p.k_rep, p.rho0_m) == (40.0, 5.0, 2.0)
 
@@ -192,7 +214,10 @@ def test_subgoal_next_to_obstacle_is_reached_only_with_subgoal_scaling():
     sub = [[5.9, 2.5]]
     s, e = np.array([0.5, 2.5]), np.array([0.5, 0.5])
     ok = follow_subgoals(g, s, e, sub, Ref6Params(subgoal_tolerance_m=0.02))
-    assert ok.success and first_visit(ok.path, sub[0], 0.02) > 0
+    assert ok.status is Status.SUCCESS and first_visit(ok.path, sub[0], 0.02) > 0
+    assert ok.info["subgoals"].tolist() == [*sub, [0.5, 0.5]]
+    assert ok.info["subgoals_reached"] == 2 and ok.info["subgoal_tolerance_m"] == 0.02
+    assert ok.path[-1].tolist() == [0.5, 0.5] and collision_free(g, ok.path)
     # scaled by the distance to the far goal, the repulsion is not zero at the sub-goal
     bad = follow_subgoals(g, s, e, sub, Ref6Params(subgoal_tolerance_m=0.02, rep_target="goal"))
     assert bad.status is Status.LOCAL_MINIMUM
@@ -267,9 +292,15 @@ def test_deterministic():
     ({"subgoal_tolerance_m": 0}, "subgoal_tolerance_m"),
     ({"k_att": -40}, "k_att"),
     ({"stall_steps": 0}, "stall_steps"),
-    ({"n": 2}, "'n'"),
 ])
 def test_bad_params_name_the_value(bad, name):
     g = paper_map(0)
-    with pytest.raises(ConfigError, match=name):
+    want = rf"^ref6\.{name}: must be .+, got {re.escape(repr(bad[name]))}$"
+    with pytest.raises(ConfigError, match=want):
         plan(g, PAPER_START, PAPER_GOAL, planner="ref6", **bad)
+
+
+def test_unknown_param_names_the_parameters():
+    with pytest.raises(ConfigError, match=r"^ref6\.n: unknown parameter \(parameters: .*"
+                                          r"\brep_exponent\b.*\)$"):
+        plan(paper_map(0), PAPER_START, PAPER_GOAL, planner="ref6", n=2)

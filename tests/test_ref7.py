@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -12,9 +13,9 @@ from hypothesis import strategies as st
 from pathfuse import Budget, ConfigError, GridMap, Status, plan
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate
-from pathfuse.planners.apf import APFParams, plan_apf
-from pathfuse.planners.ref7 import Ref7Params, follow_segments, segment_ends
+from pathfuse.planners.refs import Ref7Controller, Ref7Params, segment_ends
 from pathfuse.planners.registry import get_planner
+from pathfuse.problem import Problem
 
 S_ROWS = [
     "#########",
@@ -31,6 +32,8 @@ S_START, S_GOAL = (1.5, 1.5), (7.5, 5.5)
 def test_registered():
     spec = get_planner("ref7")
     assert spec.uses_astar and spec.params_cls is Ref7Params
+    assert spec.controller is Ref7Controller and spec.offline and spec.online
+    assert "robot_radius_m" not in spec.defaults()
     p = Ref7Params()
     assert (p.k_att, p.k_rep, p.rho0_m) == (40.0, 5.0, 2.0)
 
@@ -73,57 +76,100 @@ def test_segment_ends_properties(moves, length, k):
 
 
 # ------------------------------------------------------------------ joining the local paths
-def _pieces_oracle(g, start, targets, seg_tol):
-    """The plain APF planner run independently from each segment end to the next."""
+# A segment end is *passed* within subgoal_tolerance_m (like ref6's sub-goals): the robot
+# is not moved onto it, the attraction switches to the next end from where it stands.
+def first_visits(path, points, tol):
+    """Index of the first path point within ``tol`` of each point in turn, each visit at
+    or after the previous one (-1 when a point is never passed)."""
+    out, k = [], 0
+    for p in points:
+        d = np.hypot(*(path[k:] - np.asarray(p)).T)
+        hits = np.nonzero(d <= tol + 1e-12)[0]
+        if hits.size == 0:
+            out.append(-1)
+            break
+        k += int(hits[0])
+        out.append(k)
+    return out
+
+
+def _pieces_oracle(g, start, targets, sub_tol):
+    """The plain APF planner run independently from each segment end to the next: a piece
+    ends at the first point within ``sub_tol`` of its end (the move onto the end that
+    plan() appends is dropped), the last piece at the goal."""
     out = [np.asarray(start, dtype=float)[None]]
     pos = np.asarray(start, dtype=float)
     for i, t in enumerate(targets):
         last = i == len(targets) - 1
-        r = plan_apf(g, pos, np.asarray(t), APFParams(goal_tolerance_m=None if last else seg_tol))
+        r = plan(g, pos, t, planner="apf", goal_tolerance_m=None if last else sub_tol)
         assert r.success
-        out.append(r.path[1:])
-        pos = r.path[-1]
+        walk = r.path if last else r.path[: r.iterations + 1]
+        out.append(walk[1:])
+        pos = walk[-1]
     return np.concatenate(out)
 
 
 @pytest.mark.parametrize("kw", [{}, {"segment_points": 2}, {"segment_length_m": 1.5},
-                                {"segment_points": 1, "segment_tolerance_m": 0.2}])
+                                {"segment_points": 1, "subgoal_tolerance_m": 0.2}])
 def test_segments_join_without_gaps_or_duplicates(kw):
     g = GridMap.from_rows(S_ROWS)
     r = plan(g, S_START, S_GOAL, planner="ref7", **kw)
-    assert r.success and collision_free(g, r.path)
-    apath, idx, segs = r.info["astar_path"], r.info["segment_index"], r.info["segments"]
+    assert r.success, r.message
+    assert collision_free(g, r.path)
+    assert r.path[0].tolist() == list(S_START) and r.path[-1].tolist() == list(S_GOAL)
+    apath, idx, subs = r.info["astar_path"], r.info["segment_index"], r.info["subgoals"]
     # the segment ends are A* points (the last one the goal)
-    np.testing.assert_array_equal(segs[:-1], apath[idx[:-1]])
-    assert segs[-1].tolist() == list(S_GOAL) and idx[-1] == len(apath) - 1
+    np.testing.assert_array_equal(subs[:-1], apath[idx[:-1]])
+    assert subs[-1].tolist() == list(S_GOAL) and idx[-1] == len(apath) - 1
     np.testing.assert_array_equal(
         idx, segment_ends(apath, kw.get("segment_length_m", 3.0), kw.get("segment_points")))
-    # each segment end is in the path exactly once, in order, as a joint
-    joints = r.info["joints"]
-    assert len(joints) == len(segs) == r.info["segments_done"]
-    np.testing.assert_array_equal(r.path[joints], segs)
-    assert np.all(np.diff(joints) > 0) and joints[-1] == len(r.path) - 1
-    for s in segs:
-        assert np.sum(np.all(r.path == s, axis=1)) == 1
-    # no repeated point, no gap: every move is a step or a final move within tolerance
+    # every segment end is passed within the tolerance, in order; then the goal is reached
+    tol = r.info["subgoal_tolerance_m"]
+    assert tol == kw.get("subgoal_tolerance_m", 0.25 * g.resolution)  # a quarter cell
+    visits = first_visits(r.path, subs[:-1], tol)
+    assert -1 not in visits and visits == sorted(visits)
+    assert r.info["subgoals_reached"] == len(subs)
+    # no repeated point, no gap: every move is a force step or the final move onto the goal
     moves = np.hypot(*np.diff(r.path, axis=0).T)
     assert np.all(moves > 0)
-    assert np.all(moves <= max(r.info["step_m"], r.info["segment_tolerance_m"]) + 1e-9)
+    assert np.all(moves[:-1] <= r.info["step_m"] + 1e-9)
+    assert moves[-1] <= r.info["goal_tolerance_m"] + 1e-9
+    assert len(r.path) - 1 - r.iterations in (0, 1)
     # and the joined path is the plain APF run piece by piece
-    oracle = _pieces_oracle(g, S_START, segs, r.info["segment_tolerance_m"])
+    oracle = _pieces_oracle(g, S_START, subs, tol)
     np.testing.assert_array_equal(r.path, oracle)
     assert r.length == pytest.approx(float(moves.sum()))
 
 
-def test_follow_segments_ends_and_info():
+class GivenPath:
+    """A stand-in global plan: the controller reads only its waypoints."""
+
+    def __init__(self, waypoints):
+        self.waypoints = np.asarray(waypoints, dtype=np.float64)
+
+
+def test_given_segment_ends_and_info():
+    # with segment_points = 1 every waypoint after the start ends a segment
     g = GridMap(np.zeros((4, 6), dtype=bool))
     ends = [[2.5, 3.5], [4.5, 0.5]]
-    r = follow_segments(g, np.array([0.5, 0.5]), np.array([5.5, 2.5]), ends)
-    assert r.success and r.info["segments"].tolist() == [*ends, [5.5, 2.5]]
-    assert r.path[r.info["joints"]].tolist() == [*ends, [5.5, 2.5]]
-    # every move is a force step, but for at most one final move onto each segment end
-    assert 0 <= len(r.path) - 1 - r.iterations <= 3
-    assert r.info["segments_done"] == 3 and collision_free(g, r.path)
+    start, goal = (0.5, 0.5), (5.5, 2.5)
+    ctrl = Ref7Controller(Problem.create(g, start, goal), Ref7Params(segment_points=1),
+                          GivenPath([start, *ends, goal]))
+    r = ctrl.run(None)
+    assert r.status is Status.SUCCESS
+    assert r.info["subgoals"].tolist() == [*ends, list(goal)]
+    assert r.info["segment_index"].tolist() == [1, 2, 3]
+    assert r.info["subgoals_reached"] == 3 and r.info["subgoal_tolerance_m"] == 0.25
+    visits = first_visits(r.path, ends, 0.25)
+    assert -1 not in visits and visits == sorted(visits)
+    # the robot is not moved onto a segment end: it turns within the tolerance
+    for e in ends:
+        assert not np.any(np.all(r.path == e, axis=1))
+    # every move is a force step, but for the final move onto the goal
+    assert r.path[0].tolist() == list(start) and r.path[-1].tolist() == list(goal)
+    assert len(r.path) - 1 - r.steps in (0, 1) and r.steps > 0
+    assert collision_free(g, r.path)
+    np.testing.assert_array_equal(r.path, _pieces_oracle(g, start, [*ends, goal], 0.25))
 
 
 # ------------------------------------------------------------------ failures of a local APF
@@ -133,12 +179,15 @@ def test_local_minimum_in_a_segment_ends_the_plan_with_the_partial_path():
     g = GridMap.from_rows(["......#.", "......#.", "......#.", "......#.", "......#."])
     r = plan(g, (0.5, 2.5), (5.9, 2.5), planner="ref7", segment_points=2)
     assert r.status is Status.LOCAL_MINIMUM
-    done = r.info["segments_done"]
-    assert 1 <= done < r.info["segments"].shape[0]
-    np.testing.assert_array_equal(r.path[r.info["joints"]], r.info["segments"][:done])
+    subs = r.info["subgoals"]
+    done = r.info["subgoals_reached"]
+    assert 1 <= done < subs.shape[0]
+    tol = r.info["subgoal_tolerance_m"]
+    visits = first_visits(r.path, subs[:done], tol)
+    assert -1 not in visits and visits == sorted(visits)
     assert r.path[0].tolist() == [0.5, 2.5] and math.dist(r.path[-1], (5.9, 2.5)) > 0.15
     assert collision_free(g, r.path)
-    assert f"segment {done + 1} of" in r.message
+    assert f"sub-goal {done + 1} of {subs.shape[0]}" in r.message
 
 
 # ------------------------------------------------------------------ paper maps
@@ -147,9 +196,14 @@ def test_paper_maps_success_and_safety(seed):
     g = paper_map(seed)
     r = plan(g, PAPER_START, PAPER_GOAL, planner="ref7")
     m = evaluate(g, r)
-    assert r.success and m["collision_free"]
+    assert r.success, r.message
+    assert m["collision_free"]
     assert r.path[0].tolist() == list(PAPER_START) and r.path[-1].tolist() == list(PAPER_GOAL)
-    np.testing.assert_array_equal(r.path[r.info["joints"]], r.info["segments"])
+    subs, idx = r.info["subgoals"], r.info["segment_index"]
+    np.testing.assert_array_equal(subs[:-1], r.info["astar_path"][idx[:-1]])
+    visits = first_visits(r.path, subs[:-1], r.info["subgoal_tolerance_m"])
+    assert -1 not in visits and visits == sorted(visits)
+    assert r.info["subgoals_reached"] == subs.shape[0]
     assert r.time_s >= r.info["astar_time_s"] > 0
 
 
@@ -157,6 +211,7 @@ def test_paper_maps_success_and_safety(seed):
 def test_robot_radius(seed):
     g = paper_map(seed)
     r = plan(g, PAPER_START, PAPER_GOAL, planner="ref7", robot_radius_m=0.3)
+    assert r.path[0].tolist() == list(PAPER_START) and len(r.path) >= 2
     assert collision_free(g, r.path, robot_radius_m=0.3)
     if r.success:
         assert r.path[-1].tolist() == list(PAPER_GOAL)
@@ -174,9 +229,8 @@ def test_iteration_cap_counts_steps_over_all_segments(cap):
     g = GridMap(np.zeros((5, 40), dtype=bool))
     r = plan(g, (0.5, 2.5), (38.5, 2.5), planner="ref7", budget=Budget(max_iterations=cap))
     assert r.status is Status.MAX_ITERATIONS
-    # snap moves onto segment ends are not force steps
-    assert r.iterations == cap
-    assert cap + 1 <= len(r.path) <= cap + 1 + r.info["segments_done"]
+    # every move is a force step (segment ends are passed, not snapped onto)
+    assert r.iterations == cap and len(r.path) == cap + 1
     assert collision_free(g, r.path)
 
 
@@ -204,11 +258,19 @@ def test_deterministic():
     ({"segment_length_m": 0.0}, "segment_length_m"),
     ({"segment_points": 0}, "segment_points"),
     ({"segment_points": 2.5}, "segment_points"),
-    ({"segment_tolerance_m": -0.1}, "segment_tolerance_m"),
+    ({"subgoal_tolerance_m": -0.1}, "subgoal_tolerance_m"),
     ({"rho0_m": float("inf")}, "rho0_m"),
-    ({"segments": 3}, "'segments'"),
 ])
 def test_bad_params_name_the_value(bad, name):
     g = paper_map(0)
-    with pytest.raises(ConfigError, match=name):
+    want = rf"^ref7\.{name}: must be .+, got {re.escape(repr(bad[name]))}$"
+    with pytest.raises(ConfigError, match=want):
         plan(g, PAPER_START, PAPER_GOAL, planner="ref7", **bad)
+
+
+@pytest.mark.parametrize("name", ["segments", "segment_tolerance_m"])
+def test_unknown_params(name):
+    # segment_tolerance_m is gone: segment ends share ref6's subgoal_tolerance_m
+    with pytest.raises(ConfigError, match=rf"^ref7\.{name}: unknown parameter \(parameters: "
+                                          r".*\bsubgoal_tolerance_m\b.*\)$"):
+        plan(paper_map(0), PAPER_START, PAPER_GOAL, planner="ref7", **{name: 3})

@@ -39,7 +39,7 @@ PLUGIN = '''
 from dataclasses import dataclass
 import time
 import numpy as np
-from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.planners.registry import register_function
 from pathfuse.result import PlanResult, Status
 
 
@@ -61,7 +61,7 @@ def plan(grid, start, goal, params, budget):
                       time_s=time.perf_counter() - t0, planner="straight")
 
 
-register(PlannerSpec("straight", plan, Params, "straight segment (test plug-in)"))
+register_function("straight", plan, Params, "straight segment (test plug-in)")
 '''
 
 EXPERIMENT = f"""
@@ -113,7 +113,7 @@ def study(tmp_path_factory):
     (d / "straight_plugin.py").write_text(PLUGIN)
     (d / "exp.yaml").write_text(EXPERIMENT)
     s = run_bench(d / "exp.yaml", d / "study.db", workers=1, progress=False)
-    assert s.errors == 1 and s.ran == 48  # straight raised on paper seed 3
+    assert s.errors == 1 and s.ran == 50  # straight raised on paper seed 3
     out = d / "out"
     files = write_report(d / "study.db", out)
     return d / "study.db", out, files
@@ -232,7 +232,7 @@ def test_summary_matches_sql_per_entry_and_pooled(study):
     assert len(rows) == len(seen) + len(sql(db, "SELECT DISTINCT kind, plannerid FROM runs"))
     # every run is counted exactly once per scope kind
     entry_total = sum(int(r["runs"]) for r in rows if r["pooled"] == "False")
-    assert entry_total == sql(db, "SELECT COUNT(*) FROM runs")[0][0] == 48
+    assert entry_total == sql(db, "SELECT COUNT(*) FROM runs")[0][0] == 50
 
 
 def test_errors_and_failures_are_counted_not_dropped(study):

@@ -35,7 +35,7 @@ PLUGIN = '''
 import heapq, math, os, time
 from dataclasses import dataclass
 import numpy as np
-from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.planners.registry import register_function
 from pathfuse.result import PlanResult, Status, path_length
 
 
@@ -98,7 +98,7 @@ def plan(grid, start, goal, params, budget):
                       info={"cells": len(cells), "search_time_s": time.perf_counter() - t0})
 
 
-register(PlannerSpec("tdij", plan, Params, "test Dijkstra"))
+register_function("tdij", plan, Params, "test Dijkstra")
 '''
 
 
@@ -562,7 +562,7 @@ planners: [astar-follow, {name: apf, params: {k_att: [20, 40]}}]
             assert r["solution_length"] == pytest.approx(ep.path_length_m)
         else:
             assert r["time_to_goal"] is None and r["solution_length"] is None
-    assert {r["status_name"] for r in rows.values()} & {"REACHED"}
+    assert {r["status_name"] for r in rows.values()} & {"SUCCESS"}
 
 
 def test_workers_that_cannot_start_stop_the_sweep_at_once(tmp_path):

@@ -33,7 +33,7 @@ from pathfuse.result import (
     QueryError,
     Status,
 )
-from pathfuse.world import Episode, EpisodeStatus, World, load_scenario, simulate
+from pathfuse.world import Episode, World, load_scenario, simulate
 
 __version__ = "0.1.0"
 
@@ -65,7 +65,6 @@ __all__ = [
     "simulate",
     "World",
     "Episode",
-    "EpisodeStatus",
     "load_scenario",
     "__version__",
 ]

@@ -2,54 +2,15 @@
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
-
-import numpy as np
 
 from pathfuse.grid import GridMap
 from pathfuse.planners.registry import get_planner, make_params
-from pathfuse.result import Budget, PlanResult, QueryError, Status
+from pathfuse.planners.run import solve
+from pathfuse.problem import Problem
+from pathfuse.result import Budget, PlanResult
 
-__all__ = ["plan", "as_point", "check_query"]
-
-_WARM: set[str] = set()
-
-
-def as_point(value: object, what: str) -> np.ndarray:
-    """A finite ``(x, y)`` float array, or :class:`QueryError` naming ``what``.
-
-    >>> as_point((1, 2.5), "start").tolist()
-    [1.0, 2.5]
-    """
-    try:
-        p = np.asarray(value, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        raise QueryError(f"{what} must be two numbers (x, y), got {value!r}") from None
-    if p.shape != (2,):
-        raise QueryError(f"{what} must be two numbers (x, y), got {value!r}")
-    if not np.all(np.isfinite(p)):
-        raise QueryError(f"{what} must be finite, got {value!r}")
-    return p
-
-
-def check_query(grid: GridMap, start: np.ndarray, goal: np.ndarray) -> PlanResult | None:
-    """A failed :class:`PlanResult` when start or goal is off the map or blocked, else None."""
-    checks = (
-        (start, "start", Status.START_OUT_OF_BOUNDS, Status.START_OCCUPIED),
-        (goal, "goal", Status.GOAL_OUT_OF_BOUNDS, Status.GOAL_OCCUPIED),
-    )
-    for p, what, oob, occ in checks:
-        if not grid.in_bounds(p)[0]:
-            x0, y0, x1, y1 = grid.bounds
-            return PlanResult(
-                oob,
-                message=f"{what} ({p[0]:g}, {p[1]:g}) is outside the map "
-                f"[{x0:g}, {x1:g}) x [{y0:g}, {y1:g})",
-            )
-        if not grid.is_free(p)[0]:
-            return PlanResult(occ, message=f"{what} ({p[0]:g}, {p[1]:g}) lies in an occupied cell")
-    return None
+__all__ = ["plan"]
 
 
 def plan(
@@ -58,23 +19,33 @@ def plan(
     goal: object,
     planner: str = "astar",
     *,
+    robot_radius_m: float = 0.0,
     budget: Budget | None = None,
     **params: Any,
 ) -> PlanResult:
     """Plan a path on ``grid`` from ``start`` to ``goal`` (world coordinates, metres).
 
+    The planner's global planner (if any) runs first, then its controller
+    drives to the goal on the static map (:func:`pathfuse.simulate` runs the
+    same controller among moving obstacles).
+
     Parameters
     ----------
     grid : GridMap
-        The map.  Plan on ``grid.inflate(robot_radius)`` for a disc robot.
+        The map.
     start, goal : (float, float)
         World coordinates in metres.
     planner : str
         A name from :func:`pathfuse.planner_names` (``pathfuse planners``).
+    robot_radius_m : float
+        Radius of a disc robot (default 0: a point).  The global planner
+        searches the map with obstacles and the map's edge grown by it, and
+        every move keeps that clearance.
     budget : Budget, optional
         Iteration and time caps; every planner also has finite defaults.
     **params
-        Planner parameters (see each planner's parameter dataclass).
+        Planner parameters (see ``pathfuse planners`` or each planner's
+        parameter dataclass).
 
     Returns
     -------
@@ -84,9 +55,10 @@ def plan(
     Raises
     ------
     ConfigError
-        Unknown planner or parameter.
+        Unknown planner or parameter, a bad value, or a bad robot radius.
     QueryError
-        ``start`` or ``goal`` is not a pair of finite numbers.
+        ``start`` or ``goal`` is not a pair of finite numbers, or ``grid`` is
+        not a GridMap.
 
     Notes
     -----
@@ -102,20 +74,9 @@ def plan(
     ('SUCCESS', 5.0)
     >>> plan(g, (1.5, 1.5), (3.5, 2.5)).status.name
     'START_OCCUPIED'
+    >>> plan(g, (0.5, 0.5), (3.5, 2.5), robot_radius_m=0.6).status.name
+    'START_OCCUPIED'
     """
     spec = get_planner(planner)
     cfg = make_params(spec, params)
-    budget = budget or Budget()
-    s = as_point(start, "start")
-    g = as_point(goal, "goal")
-    if not isinstance(grid, GridMap):
-        raise QueryError(f"grid must be a pathfuse.GridMap, got {type(grid).__name__}")
-    bad = check_query(grid, s, g)
-    if bad is not None:
-        return dataclasses.replace(bad, planner=spec.name)
-    if spec.name not in _WARM:
-        if spec.warmup is not None:
-            spec.warmup()
-        _WARM.add(spec.name)
-    result = spec.func(grid, s, g, cfg, budget)
-    return dataclasses.replace(result, planner=spec.name)
+    return solve(spec, Problem.create(grid, start, goal, robot_radius_m, budget), cfg)

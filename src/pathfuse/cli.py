@@ -36,7 +36,7 @@ examples:
   pathfuse plan --map paper --seed 3 --plot plan.png
   pathfuse plan --map den312d.map --start 10.5,70.5 --goal 60.5,8.5 --json
   pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 500
-  pathfuse simulate examples/scenarios/head_on.yaml --planner astar-follow --gif head_on.gif
+  pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
   pathfuse dynamic --seeds 50 --moving 0 2 4 8 --out dynamic-out
   pathfuse bench experiments/fusion-sweep-r1-r2-step.yaml --db sweep.db --seeds 20
   pathfuse report sweep.db --out sweep-report
@@ -106,6 +106,13 @@ def _float(text: str) -> float:
     return v
 
 
+def _nonneg_float(text: str) -> float:
+    v = _float(text)
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
+    return v
+
+
 def _positive_float(text: str) -> float:
     v = _float(text)
     if v <= 0:
@@ -133,7 +140,7 @@ def parse_speed(text: str) -> tuple[float, float]:
 
 
 def parse_planner_list(text: str | None) -> tuple[str, ...]:
-    """``"fusion, astar-follow"`` -> ("fusion", "astar-follow"); None -> () (all planners)."""
+    """``"fusion, astar"`` -> ("fusion", "astar"); None -> () (all planners)."""
     if text is None:
         return ()
     names = tuple(n.strip() for n in str(text).split(",") if n.strip())
@@ -179,11 +186,11 @@ def cmd_plan(args: argparse.Namespace) -> int:
             raise CliError("--start and --goal are required unless --map paper")
     start = parse_point(args.start, "--start") if args.start else PAPER_START
     goal = parse_point(args.goal, "--goal") if args.goal else PAPER_GOAL
-    if args.robot_radius:
-        grid = grid.inflate(args.robot_radius)
     params = parse_params(args.param)
     budget = pathfuse.Budget(time_limit_s=args.time_limit) if args.time_limit else None
-    result = pathfuse.plan(grid, start, goal, planner=args.planner, budget=budget, **params)
+    _warm_with_notice(args.planner)
+    result = pathfuse.plan(grid, start, goal, planner=args.planner, budget=budget,
+                           robot_radius_m=args.robot_radius, **params)
     if args.plot:
         from pathfuse.viz import plot_plan
 
@@ -245,21 +252,66 @@ def cmd_scen(args: argparse.Namespace) -> int:
     return 0 if n_bad == 0 else EXIT_FAIL
 
 
-def cmd_planners(args: argparse.Namespace) -> int:
-    from pathfuse.planners.registry import REGISTRY, planner_names
+def _warm_with_notice(planner: str) -> None:
+    """Compile the planner's kernels now, saying so first when numba's cache is cold."""
+    from pathfuse.planners.registry import get_planner
+    from pathfuse.planners.run import warm
 
-    names = planner_names()
-    if args.json:
-        print(json.dumps({n: {"description": REGISTRY[n].description,
-                              "defaults": REGISTRY[n].defaults()} for n in names}))
-        return 0
-    width = max(len(n) for n in names)
-    for n in names:
+    def notice() -> None:
+        print("pathfuse: compiling planner kernels (first run only; cached afterwards)",
+              file=sys.stderr, flush=True)
+
+    warm(get_planner(planner), notify=notice)
+
+
+def planner_table() -> dict[str, Any]:
+    """Every registered planner as JSON-ready data (what ``pathfuse planners --json`` prints)."""
+    import dataclasses
+
+    from pathfuse.planners.registry import REGISTRY, planner_names
+    from pathfuse.validate import param_spec
+
+    out: dict[str, Any] = {}
+    for n in planner_names():
         spec = REGISTRY[n]
-        print(f"{n:<{width}}  {spec.description}")
-        defaults = ", ".join(f"{k}={v!r}" for k, v in spec.defaults().items())
-        if defaults:
-            print(f"{'':<{width}}  defaults: {defaults}")
+        params = []
+        for f in dataclasses.fields(spec.params_cls):
+            ps = param_spec(f)
+            default = getattr(spec.params_cls(), f.name)
+            params.append({
+                "name": f.name, "default": default,
+                "kind": ps.kind if ps else "", "unit": ps.unit if ps else "",
+                "accepts": ps.describe() if ps else "", "help": ps.help if ps else "",
+            })
+        ctrl = getattr(spec.controller, "label", "") if spec.controller else ""
+        out[n] = {"description": spec.description, "offline": spec.offline,
+                  "online": spec.online, "global_planner": spec.global_planner,
+                  "controller": ctrl or None, "aliases": list(spec.aliases),
+                  "params": params}
+    return out
+
+
+def cmd_planners(args: argparse.Namespace) -> int:
+    table = planner_table()
+    if args.json:
+        print(json.dumps(table))
+        return 0
+    for name, d in table.items():
+        runs = " and ".join(k for k in ("offline", "online") if d[k])
+        also = f"; also called {', '.join(d['aliases'])}" if d["aliases"] else ""
+        parts = ["global planner: A*" if d["global_planner"] == "astar" else "",
+                 f"controller: {d['controller']}" if d["controller"] else "a plug-in function"]
+        print(f"{name}  ({'; '.join(x for x in parts if x)}; runs {runs}{also})")
+        print(f"  {d['description']}")
+        if args.params:
+            for p in d["params"]:
+                unit = f" {p['unit']}" if p["unit"] and p["default"] is not None else ""
+                print(f"    {p['name']} = {p['default']!r}{unit}  ({p['accepts']}): {p['help']}")
+        else:
+            shown = ", ".join(f"{p['name']}={p['default']!r}" for p in d["params"])
+            print(f"  parameters: {shown}")
+    if not args.params:
+        print("\n'pathfuse planners --params' explains every parameter (unit, range, meaning).")
     return 0
 
 
@@ -515,8 +567,9 @@ a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolu
                    help="planner parameter, repeatable (e.g. --param heuristic=octile)")
     p.add_argument("--resolution", type=_float, help="metres per cell for image/.npy maps")
     p.add_argument("--seed", type=int, default=0, help="seed of --map paper (default 0)")
-    p.add_argument("--robot-radius", type=_float, default=0.0,
-                   help="inflate obstacles by this disc radius in metres (default 0)")
+    p.add_argument("--robot-radius", type=_nonneg_float, default=0.0,
+                   help="radius of a disc robot in metres: the path keeps this clearance "
+                   "from obstacles and the map's edge (default 0)")
     p.add_argument("--time-limit", type=_float, help="planning time limit in seconds")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", metavar="OUT.png", help="write a PNG figure of the plan")
@@ -579,20 +632,20 @@ examples:
         epilog=_fmt("""
 examples:
   pathfuse simulate examples/scenarios/head_on.yaml
-  pathfuse simulate examples/scenarios/head_on.yaml --planner astar-follow --gif head_on.gif
+  pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
   pathfuse simulate examples/scenarios/crossing.yaml --planner fusion --param repulsion=velocity
   pathfuse simulate examples/scenarios/random_walkers.yaml --seed 4 --json
   pathfuse simulate examples/scenarios/crossing.yaml --mp4 crossing.mp4 --fps 20 --frame-step 1
 
-Online planners: fusion, apf, astar-follow, astar-replan, ref6, ref7 (default: the
-scenario's planner).  GIFs are written with pillow; MP4 needs ffmpeg on PATH.  By default
+Every planner of 'pathfuse planners' runs online (default: the scenario's planner).
+GIFs are written with pillow; MP4 needs ffmpeg on PATH.  By default
 an animation plays in real time unless that takes more than 150 frames, then faster;
 --frame-step 1 draws every tick.
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     sm.add_argument("scenario", help="scenario YAML file")
-    sm.add_argument("--planner", help="online planner (default: the scenario's)")
+    sm.add_argument("--planner", help="planner (default: the scenario's)")
     sm.add_argument("--param", action="append", metavar="KEY=VALUE",
                     help="planner parameter, repeatable (e.g. --param repulsion=velocity)")
     sm.add_argument("--seed", type=_nonneg_int, default=None,
@@ -724,11 +777,16 @@ with one configuration; by default R_length is against the experiment's own refe
     r.set_defaults(func=cmd_report)
 
     q = sub.add_parser(
-        "planners", help="list the registered planners and their default parameters",
-        description="List every planner in the registry with its default parameters.",
-        epilog="example:\n  pathfuse planners --json",
+        "planners", help="list the registered planners and their parameters",
+        description="List every planner in the registry: its global planner and controller, "
+        "whether it runs offline (pathfuse plan) and online (pathfuse simulate), and its "
+        "parameters with their defaults.",
+        epilog="examples:\n  pathfuse planners\n  pathfuse planners --params\n"
+               "  pathfuse planners --json",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    q.add_argument("--params", action="store_true",
+                   help="explain every parameter: default, unit, accepted values, meaning")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=cmd_planners)
 

@@ -19,12 +19,12 @@ Markdown and CSV with a plot of the success rate against ``K``.
 
 Examples
 --------
->>> cfg = DynamicConfig(n_seeds=2, moving=(0, 1), planners=("fusion", "astar-follow"))
+>>> cfg = DynamicConfig(n_seeds=2, moving=(0, 1), planners=("fusion", "astar"))
 >>> run = run_dynamic(cfg)
 >>> len(run.records)                       # 2 disc counts x 2 scenarios x 2 planners
 8
 >>> [(r["moving"], r["planner"], r["episodes"]) for r in summary_rows(run)][:2]
-[(0, 'fusion', 2), (0, 'astar-follow', 2)]
+[(0, 'fusion', 2), (0, 'astar', 2)]
 """
 
 from __future__ import annotations
@@ -54,10 +54,10 @@ __all__ = [
 ]
 
 #: Episode statuses in table order (``EpisodeStatus`` names).
-OUTCOMES = ("REACHED", "COLLISION", "TIMEOUT", "LOCAL_MINIMUM", "NO_PATH")
-_OUTCOME_KEYS = {"REACHED": "reached", "COLLISION": "collision", "TIMEOUT": "timeout",
+OUTCOMES = ("SUCCESS", "COLLISION", "TIMEOUT", "LOCAL_MINIMUM", "NO_PATH")
+_OUTCOME_KEYS = {"SUCCESS": "reached", "COLLISION": "collision", "TIMEOUT": "timeout",
                  "LOCAL_MINIMUM": "local_minimum", "NO_PATH": "no_path"}
-_OUTCOME_LABELS = {"REACHED": "success", "COLLISION": "collision", "TIMEOUT": "timeout",
+_OUTCOME_LABELS = {"SUCCESS": "success", "COLLISION": "collision", "TIMEOUT": "timeout",
                    "LOCAL_MINIMUM": "local min", "NO_PATH": "no path"}
 
 
@@ -102,11 +102,16 @@ class DynamicConfig:
     params: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        from pathfuse.world.online import (
-            get_online_planner,
-            make_online_params,
-            online_planner_names,
-        )
+        from pathfuse.planners.registry import REGISTRY, get_planner, make_params, planner_names
+
+        def online_planner_names() -> list[str]:
+            return [n for n in planner_names() if REGISTRY[n].online]
+
+        def get_online_planner(name: str) -> Any:
+            return get_planner(name)
+
+        def make_online_params(spec: Any, params: Any, key: str) -> Any:
+            return make_params(spec, params, key=key)
 
         if not _is_int(self.n_seeds) or self.n_seeds < 1:
             raise ConfigError(f"n_seeds: expected a positive integer, got {self.n_seeds!r}")
@@ -131,12 +136,13 @@ class DynamicConfig:
         object.__setattr__(self, "speed_range", (lo, hi))
         if isinstance(self.planners, str):
             raise ConfigError(f"planners: expected a list of names, got {self.planners!r}")
-        names = tuple(dict.fromkeys(self.planners)) or tuple(online_planner_names())
-        for n in names:
+        canonical = []
+        for n in tuple(self.planners) or tuple(online_planner_names()):
             try:
-                get_online_planner(n)
+                canonical.append(get_online_planner(n).name)  # older names -> the planner's
             except ConfigError as exc:
                 raise ConfigError(f"planners: {exc}") from None
+        names = tuple(dict.fromkeys(canonical))
         object.__setattr__(self, "planners", names)
         if not isinstance(self.params, Mapping):
             raise ConfigError(f"params: expected {{planner: {{key: value}}}}, "
@@ -214,10 +220,7 @@ def _run_task(task: tuple[int, int, Any, tuple[str, ...], dict[str, Any]]
 def _worker_init() -> None:
     import signal
 
-    from pathfuse.world.online import warmup_online
-
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's business
-    warmup_online()
 
 
 def _run_pool(tasks: list[Any], workers: int
@@ -270,7 +273,6 @@ def run_dynamic(
     DynamicRun
     """
     from pathfuse.world.generate import generate_scenarios
-    from pathfuse.world.online import warmup_online
 
     cfg = config or DynamicConfig()
     if not _is_int(workers) or workers < 1:
@@ -286,7 +288,6 @@ def run_dynamic(
     results: dict[tuple[int, int], list[dict[str, Any]]] = {}
     done = 0
     if workers == 1 or len(tasks) <= 1:
-        warmup_online()
         for task in tasks:
             results[(task[0], task[1])] = _run_task(task)
             done += len(cfg.planners)
@@ -319,7 +320,7 @@ def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
                 key = _OUTCOME_KEYS[st]
                 p, lo, hi = wilson_ci(row[key], n)
                 row.update({f"{key}_rate": p, f"{key}_ci_low": lo, f"{key}_ci_high": hi})
-            ok = [r for r in recs if r["status"] == "REACHED"]
+            ok = [r for r in recs if r["status"] == "SUCCESS"]
             for col, label, unit in (("path_length_m", "path_length", "m"),
                                      ("time_to_goal_s", "time_to_goal", "s")):
                 vals = [float(r[col]) for r in ok]
@@ -344,7 +345,7 @@ def paired_rows(run: DynamicRun, reference: str = "fusion") -> list[dict[str, An
     the scenarios they disagree on more often than chance would.  Empty when
     ``reference`` was not run.
 
-    >>> cfg = DynamicConfig(n_seeds=2, moving=(1,), planners=("fusion", "astar-follow"))
+    >>> cfg = DynamicConfig(n_seeds=2, moving=(1,), planners=("fusion", "astar"))
     >>> [sorted(r)[:4] for r in paired_rows(run_dynamic(cfg))]
     [['both', 'moving', 'neither', 'only_other']]
     """
@@ -353,7 +354,7 @@ def paired_rows(run: DynamicRun, reference: str = "fusion") -> list[dict[str, An
     cfg = run.config
     if reference not in cfg.planners:
         return []
-    ok = {(r["moving"], r["index"], r["planner"]): r["status"] == "REACHED"
+    ok = {(r["moving"], r["index"], r["planner"]): r["status"] == "SUCCESS"
           for r in run.records}
     rows = []
     for k in cfg.moving:

@@ -177,14 +177,9 @@ def _grid_locked(group: Mapping[str, Any]) -> Any:
     return grid
 
 
-def _inflated(group: Mapping[str, Any], grid: Any, radius: float) -> Any:
-    if radius <= 0:
-        return grid
-    key = (group["map_key"], "inflate", float(radius))
-    with _LOCK:
-        if key not in _MAPS:
-            _lru_put(_MAPS, key, grid.inflate(radius), _MAP_CACHE_SIZE)
-        return _MAPS[key]
+def _cspace(grid: Any, radius: float) -> Any:
+    """The free space of the robot's centre (cached on the map itself)."""
+    return grid.cspace(radius) if radius > 0 else grid
 
 
 def random_query(grid: Any, seed: int, index: int, min_distance_m: float,
@@ -279,6 +274,7 @@ def _reference(group: Mapping[str, Any], run: Mapping[str, Any], pgrid: Any,
     import pathfuse
 
     res = pathfuse.plan(pgrid, start, goal, planner=ref["planner"],
+                        robot_radius_m=float(run["robot_radius_m"]),
                         budget=_budget(run["limits"]),
                         **_plan_params(ref["planner"], ref.get("params") or {}))
     val = (float(res.length), ref["planner"]) if res.success else (None, ref["planner"])
@@ -371,9 +367,8 @@ def run_static(group: Mapping[str, Any], run: Mapping[str, Any],
 
     grid = _grid(group)
     radius = float(run["robot_radius_m"])
-    pgrid = _inflated(group, grid, radius)
-    start, goal = _query_points(group, run, pgrid)
-    res = pathfuse.plan(pgrid, start, goal, planner=run["planner"],
+    start, goal = _query_points(group, run, _cspace(grid, radius))
+    res = pathfuse.plan(grid, start, goal, planner=run["planner"], robot_radius_m=radius,
                         budget=_budget(run["limits"]),
                         **_plan_params(run["planner"], run["params"]))
     path = np.asarray(res.path, dtype=float).reshape(-1, 2)
@@ -392,7 +387,7 @@ def run_static(group: Mapping[str, Any], run: Mapping[str, Any],
     row.update(_split_info(res.info or {}))
     if path.shape[0] >= 2:
         row.update(_metric_columns(_metrics(grid, res, radius)))
-    ref_len, ref_src = _reference(group, run, pgrid, start, goal)
+    ref_len, ref_src = _reference(group, run, grid, start, goal)
     row["reference_length"] = ref_len
     row["reference_source"] = ref_src
     if res.success and ref_len:
@@ -443,7 +438,7 @@ def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
     """
     status = ep.status
     name = str(getattr(status, "name", status)).upper()
-    solved = bool(getattr(ep, "reached", name == "REACHED"))
+    solved = bool(getattr(ep, "reached", name == "SUCCESS"))
     d = ep.to_dict(trajectories=False) if hasattr(ep, "to_dict") else {}
     plan_times = np.asarray(getattr(ep, "plan_times_s", ()), dtype=float)
     compute = float(getattr(ep, "setup_time_s", 0.0)) + float(plan_times.sum())

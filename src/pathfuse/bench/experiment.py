@@ -809,7 +809,7 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
     for m in maps:
         if not any(m.kind in p.kinds for p in planners):
             raise ConfigError(f"maps[{m.index}]: no planner of this experiment runs "
-                              f"{m.kind} maps (" + ("online planners of pathfuse.world: "
+                              f"{m.kind} maps (" + ("planners that run online: "
                               + ", ".join(_registry("dynamic").names()) if m.kind == "dynamic"
                               else "planners: " + ", ".join(_registry("static").names()))
                               + ")")
@@ -868,29 +868,31 @@ def _parse_reference(v: Any) -> dict[str, Any] | None:
 
 
 class _Registry:
-    """The planner registry of one run kind (static planners or online planners)."""
+    """The planners of one run kind: every planner for static maps, the planners that run
+    online (tick by tick) for dynamic entries.  One registry serves both."""
 
     def __init__(self, kind: str) -> None:
         self.kind = kind
-        if kind == "static":
-            from pathfuse.planners import registry as reg
-
-            self._names, self._get, self._make = reg.planner_names, reg.get_planner, \
-                reg.make_params
-        else:
-            from pathfuse.world import online
-
-            self._names, self._get = online.online_planner_names, online.get_online_planner
-            self._make = lambda spec, params: online.make_online_params(spec, params)
 
     def names(self) -> list[str]:
-        return list(self._names())
+        from pathfuse.planners.registry import REGISTRY, planner_names
+
+        names = planner_names()
+        return names if self.kind == "static" else [n for n in names if REGISTRY[n].online]
 
     def get(self, name: Any) -> Any:
-        return self._get(name)
+        from pathfuse.planners.registry import get_planner
+
+        spec = get_planner(name)
+        if self.kind == "dynamic" and not spec.online:
+            raise ConfigError(f"planner {spec.name!r} only plans offline; it cannot run on a "
+                              "dynamic entry")
+        return spec
 
     def make(self, spec: Any, params: Mapping[str, Any]) -> Any:
-        return self._make(spec, dict(params))
+        from pathfuse.planners.registry import make_params
+
+        return make_params(spec, dict(params), key="params")
 
 
 _REGISTRIES: dict[str, _Registry] = {}
@@ -930,6 +932,11 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         reg = _registry(kind)
         if isinstance(name, str) and name in reg.names():
             specs[kind] = reg.get(name)
+        elif isinstance(name, str):
+            try:  # an older name (alias) of a planner of this kind
+                specs[kind] = reg.get(name)
+            except ConfigError:
+                pass
     if not specs:
         if len(kinds) == 1 or not kinds:
             try:
@@ -992,10 +999,9 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
 
 
 def _strip_planner(msg: str) -> str:
-    if msg.startswith("planner '"):
+    """``params.r1_m: must be ...`` -> ``must be ...`` (the caller names the key)."""
+    if msg.startswith("params.") and ": " in msg:
         return msg.split(": ", 1)[1]
-    if msg.startswith("params."):  # online planners name the key themselves
-        return msg.split(": ", 1)[1] if ": " in msg else msg
     return msg
 
 

@@ -306,9 +306,10 @@ def swept_parameters(study: Study, names: Sequence[str] | None = None
     the parameters the study has when one is unknown).
     """
     by: dict[tuple[str, str], list[ConfigInfo]] = {}
-    for cid in study.config_ids():
-        c = study.configs[cid]
-        by.setdefault((c.kind, c.planner), []).append(c)
+    for kind in study.kinds:  # a configuration can run on static and dynamic entries alike
+        for cid in study.config_ids(kind):
+            c = study.configs[cid]
+            by.setdefault((kind, c.planner), []).append(c)
     out: dict[tuple[str, str], list[str]] = {}
     if names:
         known = sorted({k for cs in by.values() for c in cs for k in c.params})

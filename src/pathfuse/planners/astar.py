@@ -1,252 +1,209 @@
-"""The ``astar`` planner: exact 8-connected grid A* between cell centres.
+"""Grid A* as a planner: ``astar`` (follow the A* path) and ``astar-replan`` (replan at a rate).
 
-The path runs from the centre of the start cell to the centre of the goal
-cell through the centres of the cells in between; its length is the A* cost
-times the map resolution (a straight step is one cell side, a diagonal step
-``sqrt(2)`` sides).  Other planners (fusion, ref6, ref7) call
-:func:`plan_astar` directly for their global path.
+``astar``
+    Exact 8-connected grid A* between cell centres
+    (:mod:`pathfuse.planners.global_astar`).  Offline, :func:`pathfuse.plan`
+    returns the A* path through the cell centres from the start cell to the
+    goal cell; its length is the A* cost (a straight move is one cell side,
+    a diagonal ``sqrt(2)`` sides, times the resolution), and
+    ``Budget.max_iterations`` caps the expansions.  Online,
+    :func:`pathfuse.simulate` walks the path (start, centres, goal) at full
+    speed, blind to moving discs: the paper's "A* cannot handle dynamic
+    obstacles", made measurable.  ``astar-follow`` is an older name of it.
+``astar-replan``
+    Online, A* replanned every ``replan_period_s`` (default 1 s, as Nav2's
+    default behaviour tree replans at 1 Hz) on the robot's c-space with the
+    sensed discs rasterised as blocked cells (grown by the robot radius and
+    ``margin_m``), the path walked at full speed in between; with no path
+    the robot waits for the next replan.  Offline, on a static map, every
+    replan gives the first path, so ``plan()`` returns the ``astar`` path.
 
 Examples
 --------
 >>> from pathfuse.grid import GridMap
->>> from pathfuse.result import Budget
+>>> from pathfuse import plan, Budget
 >>> g = GridMap.from_rows(["....", ".##.", "...."], resolution=0.5)
->>> r = plan_astar(g, (0.25, 0.25), (1.75, 1.25), AStarParams(), Budget())
+>>> r = plan(g, (0.25, 0.25), (1.75, 1.25))
 >>> r.status.name, r.length, r.path[[0, -1]].tolist()
 ('SUCCESS', 2.5, [[0.25, 0.25], [1.75, 1.25]])
->>> cut = plan_astar(g, (0.25, 0.25), (1.75, 1.25), AStarParams(corner_cutting=True), Budget())
->>> round(cut.length, 4)
+>>> round(plan(g, (0.25, 0.25), (1.75, 1.25), corner_cutting=True).length, 4)
 2.2071
->>> plan_astar(g, (0.25, 0.25), (1.75, 1.25), AStarParams(), Budget(max_iterations=2)).status.name
+>>> plan(g, (0.25, 0.25), (1.75, 1.25), budget=Budget(max_iterations=2)).status.name
 'MAX_ITERATIONS'
->>> AStarParams(heuristic="manhattan")
+>>> plan(g, (0.25, 0.25), (1.75, 1.25), heuristic="manhattan")
 Traceback (most recent call last):
 ...
-pathfuse.result.ConfigError: astar: heuristic must be one of 'euclidean', 'octile'; got 'manhattan'
+pathfuse.result.ConfigError: astar.heuristic: must be one of 'euclidean', 'octile', got 'manhattan'
 """
 
 from __future__ import annotations
 
-import time
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
+from numba import njit
 
-from pathfuse.grid import GridMap
+from pathfuse.planners.base import Controller, Observed, Outcome
+from pathfuse.planners.global_astar import plan_global
+from pathfuse.planners.params import GlobalAStarParams
 from pathfuse.planners.registry import PlannerSpec, register
-from pathfuse.result import Budget, ConfigError, PlanResult, QueryError, Status
-from pathfuse.search.astar import HEURISTICS, SearchResult, get_searcher, warmup
+from pathfuse.problem import Problem
+from pathfuse.result import Status
+from pathfuse.validate import param
 
-__all__ = ["AStarParams", "plan_astar", "astar_cells"]
+__all__ = ["AStarParams", "ReplanParams", "FollowController", "ReplanController"]
 
 
 @dataclass(frozen=True)
-class AStarParams:
-    """Parameters of the ``astar`` planner.
+class AStarParams(GlobalAStarParams):
+    """Parameters of the ``astar`` planner."""
 
-    Attributes
-    ----------
-    heuristic : {"euclidean", "octile"}
-        ``"euclidean"`` is the straight-line distance of the paper (eq. 2);
-        ``"octile"`` is tighter on an 8-connected grid (fewer expansions).
-        Both give optimal paths.
-    corner_cutting : bool
-        ``False`` (default, MovingAI convention): a diagonal step needs both
-        orthogonally adjacent cells free.  ``True``: only the diagonal cell.
-    """
-
-    heuristic: str = "euclidean"
-    corner_cutting: bool = False
-
-    def __post_init__(self) -> None:
-        if self.heuristic not in HEURISTICS:
-            choices = ", ".join(repr(h) for h in HEURISTICS)
-            raise ConfigError(
-                f"astar: heuristic must be one of {choices}; got {self.heuristic!r}"
-            )
-        if not isinstance(self.corner_cutting, (bool, np.bool_)):
-            raise ConfigError(
-                f"astar: corner_cutting must be true or false; got {self.corner_cutting!r}"
-            )
-        object.__setattr__(self, "corner_cutting", bool(self.corner_cutting))
+    corner_cutting: bool = param(False, help="allow a diagonal move past a blocked orthogonal "
+                                             "neighbour (false: the MovingAI rule, and safe for "
+                                             "a robot)")
 
 
-def _check_cell(grid: GridMap, cell: object, what: str) -> tuple[int, int]:
-    try:
-        r, c = (int(v) for v in np.asarray(cell).reshape(-1))
-    except (TypeError, ValueError):
-        raise QueryError(f"{what} cell must be two integers (row, col), got {cell!r}") from None
-    if not (0 <= r < grid.height and 0 <= c < grid.width):
-        raise QueryError(f"{what} cell ({r}, {c}) is outside the {grid.height}x{grid.width} map")
-    if grid.occupied[r, c]:
-        raise QueryError(f"{what} cell ({r}, {c}) is occupied")
-    return r, c
+@dataclass(frozen=True)
+class ReplanParams(GlobalAStarParams):
+    """Parameters of ``astar-replan``."""
+
+    replan_period_s: float = param(1.0, gt=0, unit="s",
+                                   help="seconds between replans online (1 s = Nav2's 1 Hz)")
+    margin_m: float = param(0.0, ge=0, unit="m",
+                            help="extra clearance around each sensed disc when it is "
+                                 "rasterised")
 
 
-def astar_cells(
-    grid: GridMap,
-    start_cell: tuple[int, int],
-    goal_cell: tuple[int, int],
-    *,
-    heuristic: str = "euclidean",
-    corner_cutting: bool = False,
-    max_expansions: int | None = None,
-    time_limit_s: float | None = None,
-) -> SearchResult:
-    """Grid A* between two free ``(row, col)`` cells of ``grid``.
-
-    Returns a :class:`~pathfuse.search.astar.SearchResult` whose ``cells``
-    run from start to goal and whose ``cost`` is in cells (multiply by
-    ``grid.resolution`` for metres).  Raises :class:`QueryError` if a cell is
-    out of the map or occupied.
-
-    >>> g = GridMap.from_rows(["...", ".#.", "..."])
-    >>> r = astar_cells(g, (0, 0), (2, 2))
-    >>> r.status, r.cost, len(r.cells)
-    ('SUCCESS', 4.0, 5)
-    >>> round(astar_cells(g, (0, 0), (2, 2), corner_cutting=True).cost, 4)
-    3.4142
-    """
-    s = _check_cell(grid, start_cell, "start")
-    g = _check_cell(grid, goal_cell, "goal")
-    if heuristic not in HEURISTICS:
-        raise ConfigError(f"heuristic must be one of {HEURISTICS}, got {heuristic!r}")
-    searcher = get_searcher(grid, corner_cutting=bool(corner_cutting))
-    return searcher.search(
-        s, g, heuristic=heuristic, max_expansions=max_expansions, time_limit_s=time_limit_s
-    )
+def _point_at(path: np.ndarray, cum: np.ndarray, s: float) -> np.ndarray:
+    if s >= cum[-1]:
+        return path[-1].copy()
+    i = int(np.searchsorted(cum, s, side="right")) - 1
+    i = min(max(i, 0), len(path) - 2)
+    seg = cum[i + 1] - cum[i]
+    f = 0.0 if seg <= 0 else (s - cum[i]) / seg
+    return path[i] + f * (path[i + 1] - path[i])  # type: ignore[no-any-return]
 
 
-def plan_astar(
-    grid: GridMap,
-    start: object,
-    goal: object,
-    params: AStarParams | None = None,
-    budget: Budget | None = None,
-) -> PlanResult:
-    """Shortest 8-connected grid path from ``start`` to ``goal`` (world points, metres).
-
-    Parameters
-    ----------
-    grid : GridMap
-        The map (inflate it first for a robot with a radius).
-    start, goal : (float, float)
-        World coordinates; each is snapped to the cell it lies in.
-    params : AStarParams, optional
-    budget : Budget, optional
-        ``max_iterations`` caps expansions (default: the number of free
-        cells, which never cuts a search short); ``time_limit_s`` caps wall
-        time, checked every 65,536 expansions.
-
-    Returns
-    -------
-    PlanResult
-        ``SUCCESS`` with the cell-centre path, ``NO_PATH``,
-        ``MAX_ITERATIONS``, ``TIMEOUT``, or ``START_/GOAL_OUT_OF_BOUNDS`` /
-        ``START_/GOAL_OCCUPIED``.  ``time_s`` covers the search only: the
-        kernels are compiled, and the map's buffers built (first query on a
-        map), before the clock starts.  ``info`` holds
-        ``cells`` (the ``(row, col)`` path), ``cost_cells``, ``heuristic``
-        and ``corner_cutting``.
-    """
-    from pathfuse.api import as_point, check_query
-
-    params = params if params is not None else AStarParams()
-    budget = budget if budget is not None else Budget()
-    s = as_point(start, "start")
-    g = as_point(goal, "goal")
-    bad = check_query(grid, s, g)
-    if bad is not None:
-        return PlanResult(bad.status, planner="astar", message=bad.message)
-    warmup()
-    s_cell = tuple(int(v) for v in grid.world_to_cell(s)[0])
-    g_cell = tuple(int(v) for v in grid.world_to_cell(g)[0])
-    # per-map preparation (padded copy, buffers, labels) happens once per map and
-    # is not part of a query's time, like numba compilation
-    searcher = get_searcher(grid, corner_cutting=params.corner_cutting)
-    t0 = time.perf_counter()
-    res = searcher.search(
-        s_cell,
-        g_cell,
-        heuristic=params.heuristic,
-        max_expansions=budget.max_iterations,
-        time_limit_s=budget.time_limit_s,
-    )
-    elapsed = time.perf_counter() - t0
-    info = {
-        "cells": res.cells,
-        "cost_cells": res.cost,
-        "heuristic": params.heuristic,
-        "corner_cutting": params.corner_cutting,
-    }
-    status = Status[res.status]
-    if status is Status.SUCCESS:
-        length = res.cost * grid.resolution
-        path = grid.cell_to_world(res.cells)
-        msg = (
-            f"path through {len(res.cells)} cells, {length:.6g} m, "
-            f"{res.expansions} expansions"
-        )
-        return PlanResult(status, path, length, elapsed, "astar", res.expansions, 0, msg, info)
-    if status is Status.NO_PATH:
-        msg = (
-            "goal is not reachable from start (different connected free regions)"
-            if res.expansions == 0
-            else f"goal is not reachable from start ({res.expansions} expansions)"
-        )
-    elif status is Status.MAX_ITERATIONS:
-        msg = f"stopped after {res.expansions} expansions (max_iterations)"
-    else:
-        msg = (
-            f"stopped after {elapsed:.3g} s > time_limit_s={budget.time_limit_s:g} "
-            f"({res.expansions} expansions)"
-        )
-    return PlanResult(
-        status, planner="astar", time_s=elapsed, expansions=res.expansions, message=msg, info=info
-    )
+def _cumlen(path: np.ndarray) -> np.ndarray:
+    return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
 
 
-register(
-    PlannerSpec(
-        name="astar",
-        func=plan_astar,
-        params_cls=AStarParams,
-        description="Exact 8-connected grid A* (euclidean or octile heuristic, "
-        "no corner cutting by default)",
-        uses_astar=True,
-        warmup=warmup,
-    )
-)
+class FollowController(Controller):
+    """Walk the global path at full speed (offline: return it as planned)."""
+
+    name = "astar"
+    label = "follow the path"
+    search_budget: ClassVar[bool] = True
+
+    def __init__(self, problem: Problem, params: Any, plan: Any = None, **kw: Any) -> None:
+        super().__init__(problem, params, plan, **kw)
+        if self.online and plan is not None:
+            self._path = plan.waypoints
+            self._cum = _cumlen(self._path)
+            self._s = 0.0
+            self._step = float(self.max_speed) * float(self.dt)  # type: ignore[arg-type]
+
+    def run(self, deadline: float | None) -> Outcome:
+        gp = self.plan
+        info = {"cells": gp.cells, "cost_cells": gp.length_m / self.problem.grid.resolution,
+                "heuristic": gp.heuristic, "corner_cutting": gp.corner_cutting}
+        return Outcome(Status.SUCCESS, gp.points, 0, 0.0, gp.message, info, gp.length_m)
+
+    def act(self, obs: Observed) -> np.ndarray:
+        self._s = min(self._s + self._step, float(self._cum[-1]))
+        target = _point_at(self._path, self._cum, self._s)
+        return (target - obs.position) / float(self.dt)  # type: ignore[no-any-return, arg-type]
 
 
-def global_astar(
-    grid: GridMap,
-    start: np.ndarray,
-    goal: np.ndarray,
-    robot_radius_m: float = 0.0,
-    time_limit_s: float | None = None,
-) -> tuple[PlanResult, dict]:
-    """Step 1 of the A*-based hybrids (fusion, ref6, ref7): the global A* path.
-
-    A* runs with the paper's settings (Euclidean heuristic, no corner
-    cutting) on the map grown by ``robot_radius_m``.  Returns the A* result
-    and the ``info`` entries every hybrid reports: ``astar_path`` ((N, 2)
-    cell centres), ``astar_length`` and ``astar_time_s``.
-    """
-    agrid = grid.inflate(robot_radius_m) if robot_radius_m > 0 else grid
-    ares = plan_astar(agrid, start, goal, _HYBRID_PARAMS, Budget(time_limit_s=time_limit_s))
-    info = {
-        "astar_path": np.asarray(ares.path, dtype=np.float64).reshape(-1, 2),
-        "astar_length": float(ares.length),
-        "astar_time_s": float(ares.time_s),
-    }
-    return ares, info
+@njit(cache=True)
+def _rasterise_discs(occ, ox, oy, res, pos, radii, grow):
+    """Block every cell whose centre is closer than ``radii[i] + grow`` to a disc centre."""
+    h, w = occ.shape
+    for i in range(pos.shape[0]):
+        rad = radii[i] + grow
+        c0 = max(int(math.floor((pos[i, 0] - rad - ox) / res)), 0)
+        c1 = min(int(math.floor((pos[i, 0] + rad - ox) / res)), w - 1)
+        r0 = max(int(math.floor((pos[i, 1] - rad - oy) / res)), 0)
+        r1 = min(int(math.floor((pos[i, 1] + rad - oy) / res)), h - 1)
+        for r in range(r0, r1 + 1):
+            cy = oy + (r + 0.5) * res - pos[i, 1]
+            for c in range(c0, c1 + 1):
+                cx = ox + (c + 0.5) * res - pos[i, 0]
+                if cx * cx + cy * cy < rad * rad:
+                    occ[r, c] = True
 
 
-def astar_failed(ares: PlanResult, planner: str, info: dict) -> PlanResult:
-    """The result of a hybrid whose A* step failed: A*'s status, an empty path."""
-    return PlanResult(ares.status, np.zeros((0, 2)), 0.0, ares.time_s, planner,
-                      ares.expansions, 0, f"A* failed: {ares.message}", info)
+class ReplanController(FollowController):
+    """A* replanned at a fixed rate around the sensed discs (see the module docstring)."""
+
+    name = "astar-replan"
+    label = "replan at a fixed rate and follow"
+
+    def __init__(self, problem: Problem, params: Any, plan: Any = None, **kw: Any) -> None:
+        super().__init__(problem, params, plan, **kw)
+        if self.online:
+            dt = float(self.dt)  # type: ignore[arg-type]
+            self._every = max(1, int(round(params.replan_period_s / dt)))
+            self._path = None  # type: ignore[assignment]
+            self.replans = 0
+            self.failed_replans = 0
+
+    def _replan(self, obs: Observed) -> None:
+        pb = self.problem
+        g = pb.grid
+        occ = g.cspace(pb.robot_radius_m).occupied.copy()
+        sens = obs.obstacles
+        if len(sens):
+            _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
+                             np.require(sens.positions, np.float64, ("C", "W")),
+                             np.require(sens.radii, np.float64, ("C", "W")),
+                             float(pb.robot_radius_m) + self.params.margin_m)
+        self.replans += 1
+        here = (float(obs.position[0]), float(obs.position[1]))
+        gp = plan_global(pb.with_start(here), self.params.heuristic, occupied=occ)
+        if not gp.success:
+            self.failed_replans += 1
+            self._path = None  # type: ignore[assignment]
+            return
+        self._path = gp.waypoints
+        self._cum = _cumlen(self._path)
+        self._s = 0.0
+        self.global_path = self._path
+
+    def act(self, obs: Observed) -> np.ndarray:
+        if obs.tick % self._every == 0:
+            self._replan(obs)
+        if self._path is None:
+            return np.zeros(2)
+        return super().act(obs)
+
+    @classmethod
+    def kernels(cls) -> Sequence[Any]:
+        return (_rasterise_discs,)
+
+    @classmethod
+    def warmup(cls) -> None:
+        occ = np.zeros((3, 4), dtype=np.bool_)
+        _rasterise_discs(occ, 0.0, 0.0, 1.0, np.ones((1, 2)), np.ones(1), 0.2)
 
 
-_HYBRID_PARAMS = AStarParams(heuristic="euclidean", corner_cutting=False)
+register(PlannerSpec(
+    name="astar",
+    params_cls=AStarParams,
+    description="exact 8-connected grid A* (euclidean or octile heuristic, no corner cutting "
+                "by default); online it walks its path blind to moving discs",
+    controller=FollowController,
+    global_planner="astar",
+    aliases=("astar-follow",),
+))
+register(PlannerSpec(
+    name="astar-replan",
+    params_cls=ReplanParams,
+    description="A* replanned at a fixed rate (default 1 Hz) with the sensed moving discs as "
+                "blocked cells; offline the same path as astar",
+    controller=ReplanController,
+    global_planner="astar",
+))

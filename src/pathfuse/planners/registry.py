@@ -1,23 +1,46 @@
 """The planner registry: one dict from name to :class:`PlannerSpec`.
 
-The CLI, the tests and the benchmarks loop over :data:`REGISTRY`, so a planner
-registered here is planned, listed, tested and benchmarked everywhere.
-A planner is a plain function ``func(grid, start, goal, params, budget) ->
-PlanResult`` whose parameters are a frozen dataclass (``params_cls``) holding
-the defaults.  :func:`pathfuse.plan` validates the query before calling it, so
-planner functions receive finite in-bounds free start and goal points.
+A planner is a *global planner* (grid A*, or none) plus a *local
+controller* (:class:`~pathfuse.planners.base.Controller`), with one frozen
+parameter dataclass holding one set of defaults.  :func:`pathfuse.plan`
+runs the controller to the goal on the static map; :func:`pathfuse.simulate`
+runs the same controller once per tick among moving discs.  The CLI, the
+study engine, the tests and the benchmarks loop over :data:`REGISTRY`, so a
+planner registered here is planned, simulated, listed, tested and
+benchmarked everywhere.
+
+A plug-in that only plans offline can register a plain function with
+:func:`register_function`: ``func(grid, start, goal, params, budget) ->
+PlanResult``.
+
+Examples
+--------
+>>> planner_names()[:6]          # the built-in planners come first, in this order
+['astar', 'astar-replan', 'apf', 'fusion', 'ref6', 'ref7']
+>>> get_planner("astar-follow").name     # an older name of the same planner
+'astar'
+>>> get_planner("fusion").online, get_planner("fusion").uses_astar
+(True, True)
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from pathfuse.result import ConfigError
 
-__all__ = ["PlannerSpec", "REGISTRY", "register", "get_planner", "make_params", "planner_names"]
+__all__ = [
+    "PlannerSpec",
+    "REGISTRY",
+    "register",
+    "register_function",
+    "get_planner",
+    "make_params",
+    "planner_names",
+]
 
 
 @dataclass(frozen=True)
@@ -28,71 +51,129 @@ class PlannerSpec:
     ----------
     name : str
         Registry key, as given to ``plan(..., planner=name)`` and ``--planner``.
-    func : callable
-        ``func(grid, start, goal, params, budget) -> PlanResult``.
     params_cls : type
-        Frozen dataclass of the planner's parameters with their defaults.
+        Frozen dataclass of the planner's parameters with their defaults
+        (fields declared with :func:`pathfuse.validate.param`).
     description : str
         One line for ``pathfuse planners``.
-    uses_astar : bool
-        Whether the planner runs grid A* first (its time includes it).
-    warmup : callable or None
-        Compiles (or loads from numba's cache) the planner's kernels, so that
-        timings never include JIT compilation.
+    controller : type or None
+        The :class:`~pathfuse.planners.base.Controller` subclass; it runs
+        offline (:func:`pathfuse.plan`) and online (:func:`pathfuse.simulate`).
+    global_planner : {"astar", None}
+        The global planner run before the controller.
+    function : callable or None
+        An offline-only planner ``func(grid, start, goal, params, budget)``
+        (plug-ins registered with :func:`register_function`).
+    aliases : tuple of str
+        Older names that resolve to this planner.
     """
 
     name: str
-    func: Callable[..., Any]
     params_cls: type
     description: str
-    uses_astar: bool = False
-    warmup: Callable[[], None] | None = None
+    controller: type | None = None
+    global_planner: str | None = None
+    function: Callable[..., Any] | None = None
+    aliases: tuple[str, ...] = ()
+
+    @property
+    def uses_astar(self) -> bool:
+        """Whether grid A* runs first (its time is part of the planner's)."""
+        return self.global_planner == "astar"
+
+    @property
+    def offline(self) -> bool:
+        """Whether :func:`pathfuse.plan` can run it (every planner can)."""
+        return self.controller is not None or self.function is not None
+
+    @property
+    def online(self) -> bool:
+        """Whether :func:`pathfuse.simulate` can run it (tick by tick)."""
+        return self.controller is not None
 
     def defaults(self) -> dict[str, Any]:
+        """The default parameters as a dict."""
         return dataclasses.asdict(self.params_cls())
+
+    def capabilities(self) -> tuple[str, ...]:
+        """``("offline", "online")`` or a part of it."""
+        return tuple(c for c, ok in (("offline", self.offline), ("online", self.online)) if ok)
 
 
 REGISTRY: dict[str, PlannerSpec] = {}
+_ALIASES: dict[str, str] = {}
+_DEFAULTS: dict[str, Any] = {}
 
 
 def register(spec: PlannerSpec) -> PlannerSpec:
-    """Add ``spec`` to the registry (a later registration of a name replaces it)."""
+    """Add ``spec`` to the registry (a later registration of a name replaces it).
+
+    :func:`planner_names` lists the built-in planners first, in a fixed order,
+    then plug-ins in the order they were registered.
+    """
+    if spec.controller is None and spec.function is None:
+        raise ConfigError(f"planner {spec.name!r}: needs a controller or a function")
     REGISTRY[spec.name] = spec
+    _DEFAULTS.pop(spec.name, None)
+    for a in spec.aliases:
+        _ALIASES[a] = spec.name
     return spec
 
 
+def register_function(name: str, func: Callable[..., Any], params_cls: type,
+                      description: str) -> PlannerSpec:
+    """Register an offline-only planner ``func(grid, start, goal, params, budget) -> PlanResult``.
+
+    ``plan()`` validates the query before calling it, so ``func`` receives a
+    :class:`~pathfuse.grid.GridMap`, finite in-bounds free ``start`` and
+    ``goal`` arrays, an instance of ``params_cls`` and a
+    :class:`~pathfuse.result.Budget`.
+    """
+    return register(PlannerSpec(name, params_cls, description, function=func))
+
+
+_BUILTIN = ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7")
+
+
 def planner_names() -> list[str]:
+    """Names of the registered planners: the built-in ones first (fixed order), then plug-ins."""
     _load_builtin()
-    return list(REGISTRY)
+    order = {n: i for i, n in enumerate(_BUILTIN)}
+    names = list(REGISTRY)
+    return sorted(names, key=lambda n: (order.get(n, len(order)), names.index(n)))
 
 
 def get_planner(name: str) -> PlannerSpec:
-    """The spec registered under ``name``; :class:`ConfigError` naming the choices otherwise."""
+    """The spec registered under ``name`` (or an alias); :class:`ConfigError` listing the
+    choices otherwise."""
+    spec = REGISTRY.get(name) if isinstance(name, str) and _LOADED else None
+    if spec is not None:
+        return spec
     _load_builtin()
     try:
-        return REGISTRY[name]
+        return REGISTRY[_ALIASES.get(name, name)]
     except (KeyError, TypeError):
         raise ConfigError(
-            f"unknown planner {name!r}; choose one of: {', '.join(REGISTRY)}"
+            f"unknown planner {name!r}; choose one of: {', '.join(planner_names())}"
         ) from None
 
 
-def make_params(spec: PlannerSpec, params: dict[str, Any] | None = None) -> Any:
-    """Build ``spec.params_cls`` from a dict, naming any unknown key or bad value."""
-    params = dict(params or {})
-    fields = {f.name for f in dataclasses.fields(spec.params_cls)}
-    unknown = sorted(set(params) - fields)
-    if unknown:
-        raise ConfigError(
-            f"planner {spec.name!r} has no parameter {unknown[0]!r}; "
-            f"its parameters are: {', '.join(sorted(fields))}"
-        )
-    try:
-        return spec.params_cls(**params)
-    except ConfigError:
-        raise
-    except (TypeError, ValueError) as exc:
-        raise ConfigError(f"planner {spec.name!r}: {exc}") from None
+def make_params(spec: PlannerSpec, params: Mapping[str, Any] | None = None,
+                key: str = "", error: type[ConfigError] = ConfigError) -> Any:
+    """Build ``spec.params_cls`` from a dict, naming any unknown key or bad value.
+
+    ``key`` prefixes the message (``planners[1].params``); without it the
+    message starts with the planner's name (``fusion.r1_m: ...``).  The
+    defaults are built once.
+    """
+    if not params:
+        hit = _DEFAULTS.get(spec.name)
+        if hit is None or type(hit) is not spec.params_cls:
+            hit = _DEFAULTS[spec.name] = spec.params_cls()
+        return hit
+    from pathfuse.validate import build
+
+    return build(spec.params_cls, params, key or spec.name, error)
 
 
 _LOADED = False
@@ -106,9 +187,5 @@ def _load_builtin() -> None:
     _LOADED = True
     import importlib
 
-    for mod in ("astar", "apf", "fusion", "ref6", "ref7"):
-        try:
-            importlib.import_module(f"pathfuse.planners.{mod}")
-        except ModuleNotFoundError as exc:  # a planner not written yet
-            if exc.name != f"pathfuse.planners.{mod}":
-                raise
+    for mod in ("astar", "apf", "fusion", "refs"):
+        importlib.import_module(f"pathfuse.planners.{mod}")

@@ -57,9 +57,9 @@ Examples
 >>> occ = np.zeros((4, 5), dtype=bool); occ[1:3, 2] = True
 >>> s = AStarSearcher(occ)
 >>> r = s.search((1, 0), (1, 4))
->>> r.status, round(r.cost, 6), r.cells.tolist()
+>>> r.status.name, round(r.cost, 6), r.cells.tolist()
 ('SUCCESS', 4.828427, [[1, 0], [0, 1], [0, 2], [0, 3], [1, 4]])
->>> s.search((1, 0), (1, 4), max_expansions=2).status
+>>> s.search((1, 0), (1, 4), max_expansions=2).status.name
 'MAX_ITERATIONS'
 """
 
@@ -75,7 +75,8 @@ import numpy as np
 from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
-from scipy import ndimage
+
+from pathfuse.result import ConfigError, MapError, QueryError, Status
 
 __all__ = [
     "AStarSearcher",
@@ -447,9 +448,8 @@ class SearchResult:
 
     Attributes
     ----------
-    status : str
-        ``"SUCCESS"``, ``"NO_PATH"``, ``"MAX_ITERATIONS"`` or ``"TIMEOUT"``
-        (the names of :class:`pathfuse.result.Status` members).
+    status : Status
+        ``SUCCESS``, ``NO_PATH``, ``MAX_ITERATIONS`` or ``TIMEOUT``.
     cells : ndarray, shape (N, 2), int
         ``(row, col)`` cells from start to goal on success, else ``(0, 2)``.
     cost : float
@@ -459,7 +459,7 @@ class SearchResult:
         Nodes closed by the search (0 when answered from connectivity labels).
     """
 
-    status: str
+    status: Status
     cells: np.ndarray
     cost: float
     expansions: int
@@ -497,7 +497,7 @@ class AStarSearcher:
     ) -> None:
         occ = np.asarray(occupied, dtype=bool)
         if occ.ndim != 2 or occ.size == 0:
-            raise ValueError(f"occupied must be a non-empty 2-D array, got shape {occ.shape}")
+            raise MapError(f"occupied must be a non-empty 2-D array, got shape {occ.shape}")
         self.shape = (int(occ.shape[0]), int(occ.shape[1]))
         self.corner_cutting = bool(corner_cutting)
         h, w = self.shape
@@ -522,6 +522,8 @@ class AStarSearcher:
         self.free_count = int(n - (self._free == 0).sum())
         if labels is None:
             structure = np.ones((3, 3), dtype=bool) if self.corner_cutting else None
+            from scipy import ndimage
+
             labels, _ = ndimage.label(~occ, structure=structure)
         self._labels = np.asarray(labels)
         self.lock = threading.Lock()
@@ -547,8 +549,8 @@ class AStarSearcher:
         Parameters
         ----------
         start_cell, goal_cell : (int, int)
-            ``(row, col)``; both must be in bounds and free (``ValueError``
-            otherwise: :func:`pathfuse.planners.astar.plan_astar` checks first).
+            ``(row, col)``; both must be in bounds and free (:class:`QueryError`
+            otherwise).
         heuristic : {"euclidean", "octile"}
         max_expansions : int, optional
             Stop with ``MAX_ITERATIONS`` after this many expansions.  The
@@ -562,23 +564,24 @@ class AStarSearcher:
         SearchResult
         """
         if heuristic not in HEURISTICS:
-            raise ValueError(f"heuristic must be one of {HEURISTICS}, got {heuristic!r}")
+            raise ConfigError(f"heuristic: must be one of {', '.join(map(repr, HEURISTICS))}, "
+                              f"got {heuristic!r}")
         h, w = self.shape
         (sr, sc), (gr, gc) = (int(v) for v in start_cell), (int(v) for v in goal_cell)
         for what, r, c in (("start", sr, sc), ("goal", gr, gc)):
             if not (0 <= r < h and 0 <= c < w):
-                raise ValueError(f"{what} cell ({r}, {c}) is outside the {h}x{w} grid")
+                raise QueryError(f"{what} cell ({r}, {c}) is outside the {h}x{w} grid")
             if not self._free[(r + 1) * self._wp + c + 1]:
-                raise ValueError(f"{what} cell ({r}, {c}) is occupied")
+                raise QueryError(f"{what} cell ({r}, {c}) is occupied")
         with self.lock:
             return self._search(sr, sc, gr, gc, heuristic, max_expansions, time_limit_s)
 
     def _search(self, sr, sc, gr, gc, heuristic, max_expansions, time_limit_s) -> SearchResult:
         t0 = time.perf_counter()
         if sr == gr and sc == gc:
-            return SearchResult("SUCCESS", np.array([[sr, sc]], dtype=np.int64), 0.0, 0)
+            return SearchResult(Status.SUCCESS, np.array([[sr, sc]], dtype=np.int64), 0.0, 0)
         if self._labels[sr, sc] != self._labels[gr, gc]:
-            return SearchResult("NO_PATH", _NO_CELLS, math.inf, 0)
+            return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, 0)
         budget = self.free_count if max_expansions is None else int(max_expansions)
         wp = self._wp
         start = (sr + 1) * wp + sc + 1
@@ -603,16 +606,16 @@ class AStarSearcher:
             done += n
             if code == _FOUND:
                 cells = _trace(self._parent, start, goal, wp)
-                return SearchResult("SUCCESS", cells, float(self._g[goal]), done)
+                return SearchResult(Status.SUCCESS, cells, float(self._g[goal]), done)
             if code == _EXHAUSTED:
-                return SearchResult("NO_PATH", _NO_CELLS, math.inf, done)
+                return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, done)
             if code == _HEAP_FULL:
                 self._grow_heap()
                 continue
             if done >= budget:
-                return SearchResult("MAX_ITERATIONS", _NO_CELLS, math.inf, done)
+                return SearchResult(Status.MAX_ITERATIONS, _NO_CELLS, math.inf, done)
             if time_limit_s is not None and time.perf_counter() - t0 > time_limit_s:
-                return SearchResult("TIMEOUT", _NO_CELLS, math.inf, done)
+                return SearchResult(Status.TIMEOUT, _NO_CELLS, math.inf, done)
 
 
 # ----------------------------------------------------------------------------- cache

@@ -328,7 +328,7 @@ class _EpisodeRenderer:
         if final:
             self.outcome.set_visible(True)
             self.outcome.set_text(_outcome_text(ep))
-            self.outcome.set_color("#1a7f1a" if ep.status.name == "REACHED" else "#c00000")
+            self.outcome.set_color("#1a7f1a" if ep.status.name == "SUCCESS" else "#c00000")
             # keep the text off the robot: top or bottom third, away from it
             y_rel = (p[1] - self.ax.get_ylim()[0]) / max(np.ptp(self.ax.get_ylim()), 1e-9)
             self.outcome.set_position((0.5, 0.2 if y_rel > 0.5 else 0.8))
@@ -348,8 +348,8 @@ class _EpisodeRenderer:
 def _outcome_text(ep: Any) -> str:
     name = ep.status.name
     dt = float(ep.scenario.dt)
-    if name == "REACHED":
-        return f"REACHED in {_fmt_time(float(ep.time_to_goal_s), dt)} s, " \
+    if name == "SUCCESS":
+        return f"REACHED the goal in {_fmt_time(float(ep.time_to_goal_s), dt)} s, " \
                f"{ep.path_length_m:.2f} m"
     t = _fmt_time(float(ep.times[-1]), dt)
     if name == "COLLISION":

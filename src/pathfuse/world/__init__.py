@@ -1,4 +1,4 @@
-"""Moving obstacles: a simulated world, scenario files, online planners and the episode runner.
+"""Moving obstacles: a simulated world, scenario files and the episode runner.
 
 * :mod:`pathfuse.world.scenario` - YAML scenarios (:func:`load_scenario`,
   :class:`Scenario`) and :mod:`pathfuse.world.generate` - seeded scenario families.
@@ -6,27 +6,18 @@
   bounces, patrols, seeded random walks).
 * :mod:`pathfuse.world.world` - :class:`World` (``reset`` / ``step``) with exact
   continuous collision checks (:mod:`pathfuse.world.geometry`).
-* :mod:`pathfuse.world.online` - the online planners and their registry.
-* :mod:`pathfuse.world.episode` - :func:`simulate` and :class:`Episode`.
+* :mod:`pathfuse.world.episode` - :func:`simulate` and :class:`Episode`: any
+  registered planner, driven tick by tick.
 
 >>> from pathfuse.world import simulate
 >>> ep = simulate({"map": {"rows": ["......"]}, "start": [0.5, 0.5], "goal": [5.5, 0.5],
 ...                "robot": {"radius": 0.2}}, planner="fusion")
 >>> ep.status.name
-'REACHED'
+'SUCCESS'
 """
 
-from pathfuse.world.episode import Episode, EpisodeStatus, run_episode, simulate
+from pathfuse.world.episode import Episode, run_episode, simulate
 from pathfuse.world.obstacles import LinearObstacle, PatrolObstacle, RandomWalkObstacle
-from pathfuse.world.online import (
-    ONLINE_REGISTRY,
-    OnlinePlanner,
-    OnlinePlannerSpec,
-    PlannerContext,
-    get_online_planner,
-    online_planner_names,
-    register_online,
-)
 from pathfuse.world.scenario import (
     PlannerChoice,
     RobotSpec,
@@ -41,7 +32,6 @@ __all__ = [
     "simulate",
     "run_episode",
     "Episode",
-    "EpisodeStatus",
     "World",
     "Observation",
     "SensedObstacles",
@@ -54,11 +44,4 @@ __all__ = [
     "LinearObstacle",
     "PatrolObstacle",
     "RandomWalkObstacle",
-    "ONLINE_REGISTRY",
-    "OnlinePlanner",
-    "OnlinePlannerSpec",
-    "PlannerContext",
-    "get_online_planner",
-    "online_planner_names",
-    "register_online",
 ]

@@ -1,10 +1,11 @@
-"""The episode runner: one scenario, one online planner, one :class:`Episode` record.
+"""The episode runner: one scenario, one planner run online, one :class:`Episode` record.
 
 :func:`simulate` (exported as ``pathfuse.simulate``) reads a scenario, builds
-the :class:`~pathfuse.world.world.World` and the online planner, and steps
-them until the goal, a collision, a stall or the time limit::
+the :class:`~pathfuse.world.world.World` and the planner's controller (the
+same one :func:`pathfuse.plan` runs offline, :mod:`pathfuse.planners.run`),
+and steps them until the goal, a collision, a stall or the time limit::
 
-    ep = pathfuse.simulate("examples/scenarios/crossing.yaml", planner="astar-follow")
+    ep = pathfuse.simulate("examples/scenarios/crossing.yaml", planner="astar")
     ep.status, ep.time_to_goal_s, ep.min_distance_m
 
 The :class:`Episode` holds everything needed to analyse or animate the run:
@@ -12,21 +13,22 @@ the robot's trajectory with its times, every obstacle's position at every
 tick, the planner's global path(s), the sensing mask, per-tick planning times
 and the scene (map, radii, start, goal).
 
-Statuses
---------
-``REACHED``        the robot's centre came within ``goal_tolerance`` of the goal
+Statuses (:class:`~pathfuse.result.Status`, the one vocabulary of pathfuse):
+
+``SUCCESS``        the robot's centre came within ``goal_tolerance`` of the goal
 ``COLLISION``      the robot disc overlapped an occupied cell, the map's outside
                    or a moving disc during a tick (checked continuously)
 ``TIMEOUT``        the time limit passed
 ``LOCAL_MINIMUM``  the robot stayed within ``stall_radius`` for ``stall_time``
-                   seconds, or the planner declared itself stuck
+                   seconds
 ``NO_PATH``        a planner that needs a global path found none on the static
-                   map (the robot did not move)
+                   map (the robot did not move); ``START_/GOAL_OCCUPIED`` when a
+                   disc robot found no c-space cell near the start or goal
 """
 
 from __future__ import annotations
 
-import enum
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -35,32 +37,15 @@ from typing import Any
 import numpy as np
 
 from pathfuse.grid import GridMap
-from pathfuse.result import path_length
-from pathfuse.world.online import (
-    OnlinePlanner,
-    PlannerContext,
-    get_online_planner,
-    make_online_params,
-    resolve_planner_choice,
-)
-from pathfuse.world.scenario import Scenario, load_scenario
+from pathfuse.planners.base import Controller
+from pathfuse.planners.registry import get_planner, make_params
+from pathfuse.planners.run import start_online, warm
+from pathfuse.problem import Problem
+from pathfuse.result import ConfigError, Status, path_length
+from pathfuse.world.scenario import Scenario, load_scenario, resolve_planner_choice
 from pathfuse.world.world import World
 
-__all__ = ["Episode", "EpisodeStatus", "simulate", "run_episode"]
-
-
-class EpisodeStatus(enum.Enum):
-    """How an episode ended."""
-
-    REACHED = "reached"
-    COLLISION = "collision"
-    TIMEOUT = "timeout"
-    LOCAL_MINIMUM = "local_minimum"
-    NO_PATH = "no_path"
-
-    @property
-    def ok(self) -> bool:
-        return self is EpisodeStatus.REACHED
+__all__ = ["Episode", "simulate", "run_episode"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,10 +54,10 @@ class Episode:
 
     Attributes
     ----------
-    status : EpisodeStatus
-        How it ended.
+    status : Status
+        How it ended (``SUCCESS``: the goal was reached).
     planner : str
-        Online planner name.
+        Planner name.
     params : dict
         The planner parameters used (defaults filled in).
     times : (T,) float array
@@ -120,7 +105,7 @@ class Episode:
         The episode seed.
     """
 
-    status: EpisodeStatus
+    status: Status
     planner: str
     params: dict[str, Any]
     times: np.ndarray
@@ -146,7 +131,7 @@ class Episode:
 
     @property
     def reached(self) -> bool:
-        return self.status is EpisodeStatus.REACHED
+        return self.status is Status.SUCCESS
 
     @property
     def mean_plan_time_s(self) -> float:
@@ -204,9 +189,19 @@ def _stalled(positions: np.ndarray, n: int, window: int, radius: float) -> bool:
     return bool(d.max() < radius)
 
 
-def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = None,
-                params: dict[str, Any] | None = None) -> Episode:
-    """Run ``planner`` (an already built online planner) through ``scenario``."""
+
+def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
+                seed: int | None = None) -> Episode:
+    """Run the registered ``planner`` (with ``params``: a dict, or its parameter dataclass)
+    through ``scenario``."""
+    spec = get_planner(planner)
+    if dataclasses.is_dataclass(params) and not isinstance(params, type):
+        if type(params) is not spec.params_cls:
+            raise ConfigError(f"params: must be a {spec.params_cls.__name__} for planner "
+                              f"{spec.name!r}, got {type(params).__name__}")
+        cfg = params
+    else:
+        cfg = make_params(spec, params)
     world = World(scenario)
     sc = world.scenario
     obs = world.reset(seed)
@@ -219,15 +214,13 @@ def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = N
     positions[0] = obs.position
     sensed[0, obs.obstacles.ids] = True
 
-    ctx = PlannerContext(grid=sc.grid, start=np.array(sc.start, dtype=np.float64),
-                         goal=np.array(sc.goal, dtype=np.float64), robot=sc.robot, dt=sc.dt,
-                         goal_tolerance=sc.goal_tolerance)
-    planner.warmup()
+    problem = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius)
+    warm(spec)
     t0 = time.perf_counter()
-    planner.reset(ctx)
+    ctrl: Controller = start_online(spec, problem, cfg, float(sc.dt), float(sc.robot.max_speed))
     setup = time.perf_counter() - t0
     path_updates: list[tuple[int, np.ndarray]] = []
-    last_path = planner.global_path
+    last_path = ctrl.global_path
     if last_path is not None:
         path_updates.append((0, np.array(last_path)))
 
@@ -239,17 +232,17 @@ def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = N
             - world.obstacle_radii - world.radius
         min_obst = float(g0.min())
     window = int(round(sc.stall_time / sc.dt)) if sc.stall_time > 0 else 0
-    status = EpisodeStatus.TIMEOUT
+    status = Status.TIMEOUT
     message = ""
     collision_with = None
     n = 1
-    if planner.failure is not None:
-        status, message = _failure_status(planner)
+    if ctrl.failure is not None:
+        status, message = ctrl.failure
     else:
         while True:
             acted = obs.tick
             t0 = time.perf_counter()
-            action = planner.act(obs)
+            action = ctrl.act(obs)
             plan_times[n - 1] = time.perf_counter() - t0
             obs, terminated, truncated, info = world.step(action)
             positions[n] = obs.position
@@ -258,16 +251,16 @@ def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = N
             min_static = min(min_static, info["static_gap"])
             min_obst = min(min_obst, info["obstacle_gap"])
             n += 1
-            gp = planner.global_path
+            gp = ctrl.global_path
             if gp is not None and gp is not last_path:
                 path_updates.append((acted, np.array(gp)))
                 last_path = gp
             if terminated:
                 if info["event"] == "reached":
-                    status = EpisodeStatus.REACHED
+                    status = Status.SUCCESS
                     message = f"reached the goal at t = {obs.time:.2f} s"
                 else:
-                    status = EpisodeStatus.COLLISION
+                    status = Status.COLLISION
                     collision_with = info["collision"]
                     what = "the static map" if collision_with == "static" \
                         else f"moving obstacle {collision_with}"
@@ -277,11 +270,11 @@ def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = N
             if truncated:
                 message = f"time limit {sc.time_limit:g} s reached"
                 break
-            if planner.failure is not None:
-                status, message = _failure_status(planner)
+            if ctrl.failure is not None:
+                status, message = ctrl.failure
                 break
             if _stalled(positions, n, window, sc.stall_radius):
-                status = EpisodeStatus.LOCAL_MINIMUM
+                status = Status.LOCAL_MINIMUM
                 message = (f"stalled: stayed within {sc.stall_radius:g} m for "
                            f"{sc.stall_time:g} s (t = {obs.time:.2f} s)")
                 break
@@ -290,8 +283,8 @@ def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = N
     pos = positions[:n].copy()
     return Episode(
         status=status,
-        planner=planner.name,
-        params=dict(params or {}),
+        planner=spec.name,
+        params=dataclasses.asdict(cfg),
         times=times,
         positions=pos,
         velocities=velocities[:t].copy(),
@@ -301,7 +294,7 @@ def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = N
         global_path=None if not path_updates else path_updates[0][1],
         path_updates=path_updates,
         path_length_m=path_length(pos),
-        time_to_goal_s=float(times[-1]) if status is EpisodeStatus.REACHED else None,
+        time_to_goal_s=float(times[-1]) if status is Status.SUCCESS else None,
         min_distance_m=min(min_static, min_obst),
         min_obstacle_distance_m=min_obst,
         min_static_clearance_m=min_static,
@@ -315,12 +308,6 @@ def run_episode(scenario: Scenario, planner: OnlinePlanner, seed: int | None = N
     )
 
 
-def _failure_status(planner: OnlinePlanner) -> tuple[EpisodeStatus, str]:
-    kind, msg = planner.failure  # type: ignore[misc]
-    st = EpisodeStatus.NO_PATH if kind == "no_path" else EpisodeStatus.LOCAL_MINIMUM
-    return st, msg
-
-
 def simulate(scenario: Any, planner: Any = None, seed: int | None = None) -> Episode:
     """Simulate one episode of a dynamic scenario.
 
@@ -330,9 +317,9 @@ def simulate(scenario: Any, planner: Any = None, seed: int | None = None) -> Epi
         A scenario YAML file, the same content as a dict, or a
         :class:`~pathfuse.world.scenario.Scenario`.
     planner : str or mapping, optional
-        An online planner name (``"fusion"``, ``"apf"``, ``"astar-follow"``,
-        ``"astar-replan"``, ``"ref6"``, ``"ref7"``) or ``{"name": ...,
-        "params": {...}}``; overrides the scenario's ``planner``.
+        A planner name (``pathfuse planners``; every built-in planner runs
+        online) or ``{"name": ..., "params": {...}}``; overrides the
+        scenario's ``planner``.
     seed : int, optional
         Episode seed (default: the scenario's); the same scenario and seed
         give the same episode, bit for bit.
@@ -350,15 +337,10 @@ def simulate(scenario: Any, planner: Any = None, seed: int | None = None) -> Epi
     --------
     >>> sc = {"map": {"rows": ["........", "........", "........"]},
     ...       "start": [0.5, 1.5], "goal": [7.5, 1.5], "robot": {"radius": 0.2}}
-    >>> ep = simulate(sc, planner="astar-follow")
+    >>> ep = simulate(sc, planner="astar")
     >>> ep.status.name, ep.n_ticks, round(ep.path_length_m, 6)
-    ('REACHED', 68, 6.8)
+    ('SUCCESS', 68, 6.8)
     """
     sc = load_scenario(scenario)
     choice = resolve_planner_choice(sc.planner if planner is None else planner)
-    spec = get_online_planner(choice.name)
-    params = make_online_params(spec, choice.params, key="planner.params")
-    obj = spec.factory(params)
-    import dataclasses
-
-    return run_episode(sc, obj, seed=seed, params=dataclasses.asdict(params))
+    return run_episode(sc, choice.name, dict(choice.params), seed=seed)

@@ -46,6 +46,7 @@ import numpy as np
 
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.grid import GridMap
+from pathfuse.planners.global_astar import route as global_route
 from pathfuse.result import ConfigError
 from pathfuse.world.geometry import segment_static_distance
 from pathfuse.world.obstacles import (
@@ -54,8 +55,7 @@ from pathfuse.world.obstacles import (
     PatrolObstacle,
     RandomWalkObstacle,
 )
-from pathfuse.world.online import global_astar_path, resolve_planner_choice
-from pathfuse.world.scenario import RobotSpec, Scenario, ScenarioError
+from pathfuse.world.scenario import RobotSpec, Scenario, ScenarioError, resolve_planner_choice
 
 __all__ = ["generate_scenarios", "KINDS", "PLACEMENTS"]
 
@@ -257,7 +257,7 @@ def generate_scenarios(
         else:
             grid, mspec = fixed_grid, fixed_spec
             s, g = _start_goal(rng, grid, robot.radius, start, goal)
-        route = global_astar_path(grid, s, g, robot.radius)
+        route = global_route(grid, s, g, robot.radius)
         obstacles: list[ObstacleSpec] = []
         for j in range(int(moving)):
             for _ in range(_ATTEMPTS):
@@ -301,7 +301,7 @@ def _start_goal(rng: np.random.Generator, grid: GridMap, r: float, start: Any,
         d = float(np.hypot(*(g - s)))
         if best is not None and d <= best[0]:
             continue
-        if global_astar_path(grid, s, g, r) is None:
+        if global_route(grid, s, g, r) is None:
             continue
         best = (d, s, g)
         if d >= want:

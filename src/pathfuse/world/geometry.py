@@ -46,7 +46,7 @@ import math
 import numpy as np
 from numba import njit
 
-from pathfuse.field.stepper import segment_box_distance
+from pathfuse.geometry import segment_box_distance
 
 __all__ = [
     "segment_static_distance",

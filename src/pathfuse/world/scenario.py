@@ -55,7 +55,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -64,6 +63,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from pathfuse import validate
 from pathfuse.grid import GridMap
 from pathfuse.result import ConfigError, MapFormatError, PathfuseError
 from pathfuse.world.geometry import segment_static_distance
@@ -82,6 +82,7 @@ __all__ = [
     "load_scenario",
     "save_scenario",
     "scenario_from_dict",
+    "resolve_planner_choice",
     "SCENARIO_KEYS",
 ]
 
@@ -319,62 +320,31 @@ def _check_scene(sc: Scenario) -> None:
 
 
 # ---------------------------------------------------------------------- value parsers
-_EXP_FLOAT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
+# the checks of pathfuse.validate, raising ScenarioError
 
 
 def _num(v: Any, key: str, *, gt: float | None = None, ge: float | None = None) -> float:
-    cond = ""
-    if gt is not None:
-        cond = f" > {gt:g}"
-    elif ge is not None:
-        cond = f" >= {ge:g}"
-    msg = f"{key}: must be a number{cond}, got {v!r}"
-    if isinstance(v, str) and _EXP_FLOAT.fullmatch(v.strip()):
-        v = float(v)  # YAML 1.1 reads 1e3 as a string
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-        raise ScenarioError(msg)
-    x = float(v)
-    if not math.isfinite(x):
-        raise ScenarioError(f"{key}: must be a finite number{cond}, got {v!r}")
-    if (gt is not None and not x > gt) or (ge is not None and not x >= ge):
-        raise ScenarioError(msg)
-    return x
+    return validate.number(v, key, gt=gt, ge=ge, error=ScenarioError)
 
 
 def _int(v: Any, key: str, *, ge: int = 0) -> int:
-    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < ge:
-        raise ScenarioError(f"{key}: must be an integer >= {ge}, got {v!r}")
-    return int(v)
+    return validate.integer(v, key, ge=ge, error=ScenarioError)
 
 
 def _bool(v: Any, key: str) -> bool:
-    if not isinstance(v, (bool, np.bool_)):
-        raise ScenarioError(f"{key}: must be true or false, got {v!r}")
-    return bool(v)
+    return validate.flag(v, key, ScenarioError)
 
 
 def _str(v: Any, key: str) -> str:
-    if not isinstance(v, str):
-        raise ScenarioError(f"{key}: must be a string, got {v!r}")
-    return v
+    return validate.text(v, key, ScenarioError)
 
 
 def _point(v: Any, key: str) -> tuple[float, float]:
-    if isinstance(v, np.ndarray):
-        v = v.tolist()
-    if not isinstance(v, (list, tuple)) or len(v) != 2:
-        raise ScenarioError(f"{key}: must be two numbers [x, y], got {v!r}")
-    return (_num(v[0], f"{key}[0]"), _num(v[1], f"{key}[1]"))
+    return validate.point(v, key, ScenarioError)
 
 
 def _mapping(v: Any, key: str, allowed: tuple[str, ...], what: str = "a mapping") -> Mapping:
-    if not isinstance(v, Mapping):
-        raise ScenarioError(f"{key}: must be {what}, got {v!r}")
-    for k in v:
-        if k not in allowed:
-            name = f"{key}.{k}" if key else str(k)
-            raise ScenarioError(f"{name}: unknown key (allowed: {', '.join(allowed)})")
-    return v
+    return validate.mapping(v, key, allowed, what, ScenarioError)
 
 
 # ---------------------------------------------------------------------- section parsers
@@ -444,7 +414,7 @@ def _parse_obstacle(v: Any, index: int) -> ObstacleSpec:
 
 
 def _parse_planner(v: Any) -> PlannerChoice:
-    from pathfuse.world.online import get_online_planner, make_online_params
+    from pathfuse.planners.registry import get_planner, make_params
 
     if v is None:
         v = "fusion"
@@ -452,20 +422,30 @@ def _parse_planner(v: Any) -> PlannerChoice:
         v = {"name": v}
     m = _mapping(v, "planner", _PLANNER_KEYS, "a planner name or {name, params}")
     if "name" not in m:
-        raise ScenarioError("planner.name: missing (an online planner name)")
+        raise ScenarioError("planner.name: missing (a planner name)")
     name = _str(m["name"], "planner.name")
     params = m.get("params") or {}
     if not isinstance(params, Mapping):
-        raise ScenarioError(f"planner.params: must be a mapping, got {params!r}")
+        raise ScenarioError(f"planner.params: must be a mapping, got {validate.short(params)}")
     try:
-        spec = get_online_planner(name)
+        spec = get_planner(name)
     except ConfigError as exc:
         raise ScenarioError(f"planner.name: {exc}") from None
-    try:
-        make_online_params(spec, params, key="planner.params")
-    except ConfigError as exc:
-        raise ScenarioError(str(exc)) from None
+    if not spec.online:
+        raise ScenarioError(f"planner.name: {name!r} only plans offline (it cannot be simulated)")
+    make_params(spec, params, key="planner.params", error=ScenarioError)
     return PlannerChoice(name=spec.name, params=dict(params))
+
+
+def resolve_planner_choice(choice: Any) -> PlannerChoice:
+    """A checked :class:`PlannerChoice` from a name, ``{"name", "params"}`` or a PlannerChoice.
+
+    >>> resolve_planner_choice("astar-follow")
+    PlannerChoice(name='astar', params={})
+    """
+    if isinstance(choice, PlannerChoice):
+        return _parse_planner(choice.to_dict())
+    return _parse_planner(choice)
 
 
 def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] = ".",

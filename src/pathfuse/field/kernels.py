@@ -1,0 +1,488 @@
+"""The stepping loops of the potential-field controllers (numba), shared by plan() and simulate().
+
+Two loops serve every field controller:
+
+* :func:`field_loop` - a robot attracted by a sequence of sub-goals, the last
+  one the goal: plain APF (one sub-goal, the goal), reference method [6]
+  (the A* path's inflection points, Ge-Cui repulsion) and reference method
+  [7] (the ends of A* sub-segments, plain repulsion).
+* :func:`fusion_loop` - Algorithm 2 of the paper with pathfuse's
+  local-minimum escape.
+
+Each call steps from ``buf[n-1]`` until the goal, a stall, a block, or
+``max_steps`` force steps, and returns ``(buf, n, code, steps)`` (the path
+buffer is grown when full, so the caller keeps the returned one).
+:func:`pathfuse.plan` calls a loop once, or in chunks between wall-clock
+checks; :func:`pathfuse.simulate` calls the *same* loop with
+``max_steps = 1`` once per tick, after writing the robot's observed position
+into ``buf[n-1]`` and the sensed discs into ``dpos, dvel, drad`` (empty
+arrays on a static map, where the disc terms vanish).  So the plan a
+controller makes and the way it drives are one code path.
+
+Settings travel in small arrays (few arguments = little dispatch overhead),
+filled by :func:`pack_field` and :func:`pack_fusion`; state that persists
+between calls lives in an ``int64`` array (``state``).
+
+Codes: :data:`CODE_RUNNING` (``max_steps`` reached: call again),
+:data:`CODE_GOAL` (the robot stands on the goal), :data:`CODE_GOAL_SNAP`
+(within the goal tolerance: a straight move onto the goal was appended, not
+counted as a step), :data:`CODE_STALLED` (net move below the stall distance
+over the stall window), :data:`CODE_BLOCKED` (no collision-free move along
+the force).  :func:`code_status` maps them to :class:`~pathfuse.result.Status`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from pathfuse.field.forces import att_force_xy
+from pathfuse.field.motion import HOW_BLOCKED, safe_step, straight_move
+from pathfuse.field.pathing import advance_progress, find_rejoin
+from pathfuse.field.repulsion import (
+    disc_repulsion,
+    fusion_force,
+    grid_improved_repulsion,
+    grid_repulsion,
+)
+from pathfuse.geometry import segment_is_clear
+from pathfuse.result import Status
+
+__all__ = [
+    "CODE_RUNNING",
+    "CODE_GOAL",
+    "CODE_STALLED",
+    "CODE_BLOCKED",
+    "CODE_GOAL_SNAP",
+    "code_status",
+    "field_loop",
+    "fusion_loop",
+    "pack_field",
+    "pack_fusion",
+]
+
+CODE_RUNNING = 0
+CODE_GOAL = 1
+CODE_STALLED = 2
+CODE_BLOCKED = 3
+CODE_GOAL_SNAP = 4
+
+# --- float settings shared by both loops (slots 0..19)
+F_GX, F_GY, F_KATT, F_KREP, F_RHO0, F_STEP, F_TOL, F_CLEAR, F_STALLD, F_OX = range(10)
+F_OY, F_RES, F_RADIUS, F_KMOV, F_RHOMOV, F_REACH, F_AMAX, F_SWERVE, F_RVX, F_RVY = range(10, 20)
+# field_loop only
+F_SUBTOL, F_NEXP, F_SCALE = 20, 21, 22
+# fusion_loop only
+F_R1, F_R2, F_BACKOFF = 20, 21, 22
+N_F = 23
+# --- int settings
+I_STALLN, I_VELAWARE = 0, 1
+I_IMPROVED, I_TOGOAL = 2, 3  # field_loop
+I_AHEAD, I_ESCAPE, I_ESC_PTS, I_DRIVE = 2, 3, 4, 5  # fusion_loop
+N_I = 6
+# --- state
+S_SUB = 0  # field_loop: current sub-goal index
+# fusion_loop: progress index, mode (0 Algorithm 2, 1 escape along path points,
+# 2 driving back along the walk), stall reference point, escape exit index, escapes,
+# escape target index, steps dropped (planning) or driven back, walk-back target
+# index, walk-back stop index, steps since the last escape target
+S_K, S_MODE, S_REF, S_ESC_K, S_ESCAPES, S_T, S_BACKOFF, S_WB, S_WI, S_ESTEPS = range(10)
+N_S = 10
+
+
+def code_status(code: int, steps: int, max_steps: int) -> Status:
+    """The :class:`~pathfuse.result.Status` of a finished loop."""
+    if code == CODE_GOAL or code == CODE_GOAL_SNAP:
+        return Status.SUCCESS
+    if code == CODE_STALLED or code == CODE_BLOCKED:
+        return Status.LOCAL_MINIMUM
+    if steps >= max_steps:
+        return Status.MAX_ITERATIONS
+    return Status.TIMEOUT
+
+
+# --------------------------------------------------------------------- shared pieces
+@njit(cache=True, inline="always")
+def _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear):
+    """Goal test: append the goal when within ``tol`` and the move onto it is clear."""
+    ex = x - gx
+    ey = y - gy
+    if ex * ex + ey * ey <= tol * tol:
+        if x == gx and y == gy:
+            return n, CODE_GOAL
+        if segment_is_clear(x, y, gx, gy, occ, ox, oy, res, clear):
+            buf[n, 0] = gx
+            buf[n, 1] = gy
+            return n + 1, CODE_GOAL_SNAP
+    return n, CODE_RUNNING
+
+
+@njit(cache=True, inline="always")
+def _discs(x, y, fx, fy, f, i, dpos, dvel, drad):
+    """The sensed discs' repulsion for a robot heading along ``(fx, fy)``."""
+    if drad.shape[0] == 0:
+        return 0.0, 0.0
+    fn = math.hypot(fx, fy)
+    ux = fx / fn if fn > 0.0 else 0.0
+    uy = fy / fn if fn > 0.0 else 0.0
+    return disc_repulsion(x, y, f[F_RVX], f[F_RVY], f[F_RADIUS], dpos, dvel, drad, f[F_KMOV],
+                          f[F_RHOMOV], f[F_REACH], i[I_VELAWARE] == 1, f[F_AMAX], f[F_SWERVE],
+                          ux, uy)
+
+
+@njit(cache=True, inline="always")
+def _grow(buf, n):
+    if n + 2 <= buf.shape[0]:
+        return buf
+    nb = np.empty((2 * buf.shape[0], 2))
+    nb[:n] = buf[:n]
+    return nb
+
+
+@njit(cache=True, inline="always")
+def _grow_int(kbuf, n):
+    if n + 2 <= kbuf.shape[0]:
+        return kbuf
+    nk = np.empty(2 * kbuf.shape[0], dtype=np.int64)
+    nk[:n] = kbuf[:n]
+    return nk
+
+
+# --------------------------------------------------------------------- field loop
+@njit(cache=True)
+def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
+    """APF steps through the sub-goals ``subs`` (K, 2), the last one the goal.
+
+    The current sub-goal ``subs[state[S_SUB]]`` attracts (eq. 5); it is
+    passed when the robot comes within the sub-goal tolerance.  Repulsion:
+    eq. 6 from the cells within ``rho0`` (plain) or the Ge-Cui form towards
+    the sub-goal or the goal (``I_IMPROVED``, ``I_TOGOAL``), plus the sensed
+    discs.  The goal test runs before every step.  Returns ``(buf, n, code,
+    steps)``.
+    """
+    gx = f[F_GX]
+    gy = f[F_GY]
+    k_att = f[F_KATT]
+    k_rep = f[F_KREP]
+    rho0 = f[F_RHO0]
+    step = f[F_STEP]
+    tol = f[F_TOL]
+    clear = f[F_CLEAR]
+    stall_d = f[F_STALLD]
+    ox = f[F_OX]
+    oy = f[F_OY]
+    res = f[F_RES]
+    sub_tol = f[F_SUBTOL]
+    nexp = f[F_NEXP]
+    scale = f[F_SCALE]
+    stall_n = i[I_STALLN]
+    improved = i[I_IMPROVED] == 1
+    to_goal = i[I_TOGOAL] == 1
+    last = subs.shape[0] - 1
+    j = state[S_SUB]
+    x = buf[n - 1, 0]
+    y = buf[n - 1, 1]
+    steps = 0
+    code = CODE_RUNNING
+    while True:
+        if j < last and math.hypot(x - subs[j, 0], y - subs[j, 1]) <= sub_tol:
+            j += 1
+            continue
+        buf = _grow(buf, n)
+        if j == last:
+            n, done = _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear)
+            if done != CODE_RUNNING:
+                code = done
+                break
+        if steps >= max_steps:
+            break
+        sx = subs[j, 0]
+        sy = subs[j, 1]
+        fx, fy = att_force_xy(x, y, sx, sy, k_att)
+        if improved:
+            tx = gx if to_goal else sx
+            ty = gy if to_goal else sy
+            rx, ry = grid_improved_repulsion(x, y, tx, ty, occ, ox, oy, res, k_rep, rho0, nexp,
+                                             scale)
+        else:
+            rx, ry = grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0, rho0)
+        fx += rx
+        fy += ry
+        dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
+        nx, ny, how = safe_step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear)
+        if how == HOW_BLOCKED:
+            code = CODE_BLOCKED
+            break
+        buf[n, 0] = nx
+        buf[n, 1] = ny
+        n += 1
+        steps += 1
+        x = nx
+        y = ny
+        if n - 1 >= stall_n:
+            p = n - 1 - stall_n
+            if math.hypot(x - buf[p, 0], y - buf[p, 1]) < stall_d:
+                code = CODE_STALLED
+                break
+    state[S_SUB] = j
+    return buf, n, code, steps
+
+
+def pack_field(goal, k_att, k_rep, rho0_m, step_m, tol_m, clear_m, stall_steps,
+               stall_distance_m, ox, oy, res, subgoal_tol_m, improved, to_goal, rep_exponent,
+               rep_scale_m, discs):
+    """Float and int settings of :func:`field_loop`; ``discs`` is :func:`disc_settings`."""
+    f = np.zeros(N_F)
+    f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
+    f[F_KATT], f[F_KREP], f[F_RHO0] = k_att, k_rep, rho0_m
+    f[F_STEP], f[F_TOL], f[F_CLEAR], f[F_STALLD] = step_m, tol_m, clear_m, stall_distance_m
+    f[F_OX], f[F_OY], f[F_RES] = ox, oy, res
+    f[F_SUBTOL], f[F_NEXP], f[F_SCALE] = subgoal_tol_m, rep_exponent, rep_scale_m
+    i = np.zeros(N_I, dtype=np.int64)
+    i[I_STALLN] = stall_steps
+    i[I_IMPROVED] = 1 if improved else 0
+    i[I_TOGOAL] = 1 if to_goal else 0
+    _put_discs(f, i, discs)
+    return f, i
+
+
+def disc_settings(robot_radius_m, k_rep_moving, rho0_moving_m, reach_m, velocity_aware, a_max,
+                  swerve):
+    """The moving-disc settings of both loops, as a tuple for :func:`pack_field`."""
+    return (robot_radius_m, k_rep_moving, rho0_moving_m, reach_m, velocity_aware, a_max, swerve)
+
+
+def _put_discs(f, i, discs):
+    r, k, rho, reach, va, a_max, swerve = discs
+    f[F_RADIUS], f[F_KMOV], f[F_RHOMOV], f[F_REACH] = r, k, rho, reach
+    f[F_AMAX], f[F_SWERVE] = a_max, swerve
+    i[I_VELAWARE] = 1 if va else 0
+
+
+# --------------------------------------------------------------------- fusion loop
+@njit(cache=True, inline="always")
+def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, drad):
+    """One escape move towards ``(tx, ty)``: ``(nx, ny, moved, reached)``.
+
+    Without a disc in reach: a straight move of at most one step, landing
+    exactly on the target (the move must be clear).  With discs in reach:
+    a pull towards the target of the size of a path point ``r1`` away, plus
+    the discs' repulsion, taken as a safe step; the target counts as reached
+    within half a step.
+    """
+    d = math.hypot(tx - x, ty - y)
+    dfx = 0.0
+    dfy = 0.0
+    if drad.shape[0] > 0 and d > 0.0:
+        dfx, dfy = _discs(x, y, tx - x, ty - y, f, i, dpos, dvel, drad)
+    if dfx == 0.0 and dfy == 0.0:
+        nx, ny, landed = straight_move(x, y, tx, ty, step)
+        if segment_is_clear(x, y, nx, ny, occ, ox, oy, res, clear):
+            return nx, ny, True, landed
+        return x, y, False, False
+    pull = f[F_KATT] * f[F_R1] / d
+    nx, ny, how = safe_step(x, y, pull * (tx - x) + dfx, pull * (ty - y) + dfy, step, occ, ox,
+                            oy, res, clear)
+    if how == HOW_BLOCKED:
+        return x, y, False, False
+    return nx, ny, True, math.hypot(tx - nx, ty - ny) <= 0.5 * step
+
+
+@njit(cache=True)
+def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel, drad):
+    """Algorithm 2 steps from ``buf[n-1]`` along the global path ``pts`` (M, 2).
+
+    ``pts`` ends at the goal, ``cum`` (M,) is its cumulative arc length,
+    ``kbuf`` (as long as ``buf``) receives the progress index at each walked
+    point (``kbuf[0] = 0``).  Returns ``(buf, kbuf, n, code, steps)``.
+
+    Mode 0 is Algorithm 2: the progress index moves on
+    (:func:`~pathfuse.field.pathing.advance_progress`), the goal and the path
+    points ahead within ``r1`` attract, the cells within ``r2`` and the
+    sensed discs repel, one safe step.
+
+    Escape (``I_ESCAPE``): when the robot stalls or is blocked it picks a
+    walked point and a path point to rejoin from
+    (:func:`~pathfuse.field.pathing.find_rejoin`, with ``rvis = r1 + res``).
+    Planning (``I_DRIVE`` = 0) drops the walk after that point from the path
+    and continues from there; driving (``I_DRIVE`` = 1) walks back along its
+    own trail to it (mode 2).  Then the robot goes straight to the chosen path
+    point and follows the path points one by one until it is
+    ``escape_points`` past its progress at the stall (mode 1); then
+    Algorithm 2 resumes.  A blocked escape move ends the escape, and so does
+    an escape held up by sensed discs for twice the stall window; a call that
+    turns ``4 M + 64`` times without moving ends as blocked (every loop
+    ends).
+    """
+    gx = f[F_GX]
+    gy = f[F_GY]
+    k_att = f[F_KATT]
+    k_rep = f[F_KREP]
+    rho0 = f[F_RHO0]
+    r1 = f[F_R1]
+    r2 = f[F_R2]
+    backoff_window = f[F_BACKOFF]
+    step = f[F_STEP]
+    tol = f[F_TOL]
+    clear = f[F_CLEAR]
+    stall_d = f[F_STALLD]
+    ox = f[F_OX]
+    oy = f[F_OY]
+    res = f[F_RES]
+    stall_n = i[I_STALLN]
+    ahead = i[I_AHEAD]
+    escape = i[I_ESCAPE]
+    esc_pts = i[I_ESC_PTS]
+    drive = i[I_DRIVE] == 1
+    m = pts.shape[0]
+    k = state[S_K]
+    mode = state[S_MODE]
+    ref = state[S_REF]
+    esc_k = state[S_ESC_K]
+    escapes = state[S_ESCAPES]
+    t = state[S_T]
+    backoff = state[S_BACKOFF]
+    wb = state[S_WB]
+    wi = state[S_WI]
+    esteps = state[S_ESTEPS]
+    x = buf[n - 1, 0]
+    y = buf[n - 1, 1]
+    code = CODE_RUNNING
+    steps = 0
+    idle = 0  # loop turns since the last move: escapes that cannot move end as blocked
+    idle_cap = 4 * m + 64
+    while True:
+        idle += 1
+        if idle > idle_cap:
+            code = CODE_BLOCKED
+            break
+        buf = _grow(buf, n)
+        kbuf = _grow_int(kbuf, n)
+        n, done = _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear)
+        if done != CODE_RUNNING:
+            code = done
+            break
+        if steps >= max_steps:
+            break
+        stalled = False
+        blocked = False
+        if mode == 0:
+            k = advance_progress(x, y, pts, cum, k, r1, occ, ox, oy, res, clear)
+            fx, fy, _ = fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0,
+                                     r1, r2, occ, ox, oy, res)
+            dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
+            nx, ny, how = safe_step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear)
+            if how == HOW_BLOCKED:
+                blocked = True
+            else:
+                buf[n, 0] = nx
+                buf[n, 1] = ny
+                kbuf[n] = k
+                n += 1
+                steps += 1
+                idle = 0
+                x = nx
+                y = ny
+                if n - 1 - ref >= stall_n:
+                    p = n - 1 - stall_n
+                    ex = x - buf[p, 0]
+                    ey = y - buf[p, 1]
+                    stalled = ex * ex + ey * ey < stall_d * stall_d
+        else:
+            # escape: towards the next walked point (mode 2) or path point (mode 1)
+            if mode == 2:
+                tx = buf[wb, 0]
+                ty = buf[wb, 1]
+            else:
+                tx = pts[t, 0]
+                ty = pts[t, 1]
+            if x == tx and y == ty:
+                reached = True
+            else:
+                nx, ny, moved, reached = _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy,
+                                                      res, clear, dpos, dvel, drad)
+                esteps += 1
+                if not moved or (drad.shape[0] > 0 and esteps > 2 * stall_n):
+                    mode = 0  # blocked (or held up by discs): back to Algorithm 2
+                    ref = n - 1
+                    continue
+                buf[n, 0] = nx
+                buf[n, 1] = ny
+                kbuf[n] = k
+                n += 1
+                steps += 1
+                idle = 0
+                x = nx
+                y = ny
+            if reached:
+                esteps = 0
+                if mode == 2:
+                    if wb <= wi:
+                        mode = 1
+                    else:
+                        wb -= 1
+                else:
+                    if t > k:
+                        k = t
+                    if t >= esc_k or t >= m - 1:
+                        mode = 0
+                        ref = n - 1
+                    else:
+                        t += 1
+        if stalled or blocked:
+            ri = -1
+            rj = -1
+            if escape == 1:
+                ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox, oy,
+                                     res, clear, kbuf, drive)
+            if ri < 0:
+                code = CODE_BLOCKED if blocked else CODE_STALLED
+                break
+            escapes += 1
+            backoff += n - 1 - ri
+            if drive and ri < n - 1:
+                mode = 2
+                wb = n - 2
+                wi = ri
+            else:
+                n = ri + 1
+                x = buf[ri, 0]
+                y = buf[ri, 1]
+                mode = 1
+            esteps = 0
+            t = rj
+            esc_k = min(max(k, rj) + esc_pts, m - 1)
+            ref = n - 1
+    state[S_K] = k
+    state[S_MODE] = mode
+    state[S_REF] = ref
+    state[S_ESC_K] = esc_k
+    state[S_ESCAPES] = escapes
+    state[S_T] = t
+    state[S_BACKOFF] = backoff
+    state[S_WB] = wb
+    state[S_WI] = wi
+    state[S_ESTEPS] = esteps
+    return buf, kbuf, n, code, steps
+
+
+def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, stall_steps,
+                stall_distance_m, ox, oy, res, ahead, escape, escape_points, backoff_window_m,
+                drive, discs):
+    """Float and int settings of :func:`fusion_loop` (``r2_m`` is the repulsion radius)."""
+    f = np.zeros(N_F)
+    f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
+    f[F_KATT], f[F_KREP], f[F_RHO0] = k_att, k_rep, rho0_m
+    f[F_STEP], f[F_TOL], f[F_CLEAR], f[F_STALLD] = step_m, tol_m, clear_m, stall_distance_m
+    f[F_OX], f[F_OY], f[F_RES] = ox, oy, res
+    f[F_R1], f[F_R2], f[F_BACKOFF] = r1_m, r2_m, backoff_window_m
+    i = np.zeros(N_I, dtype=np.int64)
+    i[I_STALLN] = stall_steps
+    i[I_AHEAD] = ahead
+    i[I_ESCAPE] = 1 if escape else 0
+    i[I_ESC_PTS] = escape_points
+    i[I_DRIVE] = 1 if drive else 0
+    _put_discs(f, i, discs)
+    return f, i

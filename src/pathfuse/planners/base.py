@@ -1,0 +1,312 @@
+"""Local controllers: what a planner does after (or without) its global plan.
+
+A :class:`Controller` is built for one problem and runs it one of two ways:
+
+* :meth:`Controller.run` - offline, as :func:`pathfuse.plan` does: to the goal
+  on the static map, in one numba call (or in chunks between wall-clock
+  checks under a time limit); returns an :class:`Outcome`.
+* :meth:`Controller.act` - online, as :func:`pathfuse.simulate` does: one
+  velocity per tick from an observation (the robot's position and velocity,
+  the sensed moving discs).
+
+:class:`FieldController` is the base of the potential-field controllers
+(``apf``, ``fusion``, ``ref6``, ``ref7``): both ways call the same numba loop
+of :mod:`pathfuse.field.kernels`, offline with a budget of many moves and
+no discs, online with a budget of one move and the sensed discs.  The move
+length is the parameter ``step_m`` offline and ``max_speed * dt`` online.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Protocol
+
+import numpy as np
+
+from pathfuse.field.kernels import (
+    CODE_BLOCKED,
+    CODE_GOAL,
+    CODE_GOAL_SNAP,
+    CODE_RUNNING,
+    CODE_STALLED,
+    F_RVX,
+    F_RVY,
+    code_status,
+    disc_settings,
+)
+from pathfuse.field.motion import MARGIN_FRAC
+from pathfuse.geometry import segment_is_clear
+from pathfuse.problem import Problem
+from pathfuse.result import Status
+
+__all__ = ["Outcome", "Controller", "FieldController", "Observed", "CHUNK", "CAP_FACTOR",
+           "STALL_FRAC"]
+
+#: Moves per numba call between wall-clock checks when a time limit is set.
+CHUNK = 8192
+#: Default move cap: this many times (width + height) / step, plus 1000.
+CAP_FACTOR = 10.0
+#: Default stall distance, in moves.
+STALL_FRAC = 2.5
+
+_NO_DISCS = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0))
+
+
+def _plain(a: Any) -> np.ndarray:
+    """A C-contiguous writable float64 array (one numba signature for every caller)."""
+    return np.require(a, dtype=np.float64, requirements=("C", "W"))
+
+
+class Observed(Protocol):
+    """What an online controller reads from an observation (see :class:`pathfuse.world.World`)."""
+
+    tick: int
+    position: np.ndarray
+    velocity: np.ndarray
+    obstacles: Any  # positions (M, 2), velocities (M, 2), radii (M,), len()
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What an offline run of a controller returns (``plan()`` turns it into a PlanResult)."""
+
+    status: Status
+    path: np.ndarray
+    steps: int
+    time_s: float
+    message: str
+    info: dict[str, Any] = field(default_factory=dict)
+    length_m: float | None = None
+    """The path's length when the controller knows it exactly (A*'s cost); else summed."""
+
+
+class Controller:
+    """A local controller for one problem: :meth:`run` offline, :meth:`act` online.
+
+    Parameters
+    ----------
+    problem : Problem
+    params : dataclass
+        The planner's parameters.
+    plan : GlobalPlan or None
+        The global plan (None for a planner without one, such as ``apf``).
+    dt, max_speed : float, optional
+        Given online: the tick length (s) and the robot's speed limit (m/s).
+
+    Attributes
+    ----------
+    global_path : (N, 2) array or None
+        The path the controller currently follows (a new array object each
+        time it changes, so an episode can record replans).
+    failure : (Status, str) or None
+        Set online when the controller gives up (the episode ends with that
+        status).
+    """
+
+    name: ClassVar[str] = ""
+    label: ClassVar[str] = ""
+    """What the controller does, in a few words (``pathfuse planners``)."""
+    search_budget: ClassVar[bool] = False
+    """Whether ``Budget.max_iterations`` caps the global search (``astar``) rather than the
+    controller's moves."""
+
+    def __init__(self, problem: Problem, params: Any, plan: Any = None, *,
+                 dt: float | None = None, max_speed: float | None = None) -> None:
+        self.problem = problem
+        self.params = params
+        self.plan = plan
+        self.dt = dt
+        self.max_speed = max_speed
+        self.online = dt is not None
+        self.global_path: np.ndarray | None = None if plan is None else plan.waypoints
+        self.failure: tuple[Status, str] | None = None
+
+    def run(self, deadline: float | None) -> Outcome:  # pragma: no cover - abstract
+        """Drive to the goal on the static map (``deadline``: a ``perf_counter`` value)."""
+        raise NotImplementedError
+
+    def act(self, obs: Observed) -> np.ndarray:  # pragma: no cover - abstract
+        """The velocity ``(vx, vy)`` for this tick."""
+        raise NotImplementedError
+
+    @classmethod
+    def kernels(cls) -> Sequence[Any]:
+        """The numba kernels this controller runs (to tell a cold cache)."""
+        return ()
+
+    @classmethod
+    def warmup(cls) -> None:
+        """Compile (or load from numba's cache) the kernels this controller runs."""
+
+
+class FieldController(Controller):
+    """Shared logic of the potential-field controllers (see the module docstring).
+
+    Subclasses set :attr:`default_step_frac`, fill the settings arrays
+    ``self.f`` and ``self.i`` of their loop, and implement :meth:`_call`, which
+    runs the loop for at most ``max_steps`` moves from ``self.buf[self.n -
+    1]`` and returns ``(code, steps)``.
+    """
+
+    default_step_frac: ClassVar[float] = 0.1
+    disc_reach_m: float = math.inf
+    f: np.ndarray
+    i: np.ndarray
+
+    def __init__(self, problem: Problem, params: Any, plan: Any = None, *,
+                 dt: float | None = None, max_speed: float | None = None) -> None:
+        super().__init__(problem, params, plan, dt=dt, max_speed=max_speed)
+        p = params
+        g = problem.grid
+        res = g.resolution
+        if self.online:
+            step = float(max_speed) * float(dt)  # type: ignore[arg-type]
+        else:
+            step = float(p.step_m) if p.step_m is not None else self.default_step_frac * res
+        self.step_m = step
+        self.goal_tolerance_m = float(p.goal_tolerance_m) if p.goal_tolerance_m is not None \
+            else step
+        self.stall_distance_m = float(p.stall_distance_m) if p.stall_distance_m is not None \
+            else STALL_FRAC * step
+        self.clear_m = problem.robot_radius_m + MARGIN_FRAC * res
+        cap = problem.budget.max_iterations
+        self.max_steps = int(cap) if cap is not None else \
+            int(math.ceil(CAP_FACTOR * (g.width + g.height) * res / step)) + 1000
+        size = 1024 if self.online else min(self.max_steps, 1022) + 2
+        self.buf = np.empty((size, 2))
+        self.buf[0] = problem.start
+        self.n = 1
+
+    def disc_settings(self) -> tuple:
+        """Moving-disc settings for the kernels (no effect without discs)."""
+        p = self.params
+        return disc_settings(
+            self.problem.robot_radius_m,
+            p.k_rep if p.k_rep_moving is None else p.k_rep_moving,
+            p.rho0_m if p.rho0_moving_m is None else p.rho0_moving_m,
+            self.disc_reach_m, p.repulsion == "velocity", p.a_max, p.swerve)
+
+    def _call(self, max_steps: int, dpos: np.ndarray, dvel: np.ndarray,
+              drad: np.ndarray) -> tuple[int, int]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------ offline
+    def run(self, deadline: float | None) -> Outcome:
+        """Step to the goal, a local minimum, the move cap or the deadline."""
+        t0 = time.perf_counter()
+        total = 0
+        code = CODE_RUNNING
+        while True:
+            left = self.max_steps - total
+            chunk = left if deadline is None else min(CHUNK, left)
+            code, steps = self._call(chunk, *_NO_DISCS)
+            total += steps
+            if code != CODE_RUNNING or total >= self.max_steps:
+                break
+            if deadline is not None and time.perf_counter() > deadline:
+                break
+        elapsed = time.perf_counter() - t0
+        status = code_status(code, total, self.max_steps)
+        path = self.buf[: self.n].copy()
+        info = {"step_m": self.step_m, "goal_tolerance_m": self.goal_tolerance_m,
+                "step_time_s": elapsed, "steps_per_s": total / elapsed if elapsed > 0 else 0.0}
+        info.update(self.extra_info())
+        if status is Status.SUCCESS:
+            msg = self.success_message(total)
+        else:
+            msg = self.failure_message(code, status, path, total)
+        return Outcome(status, path, total, elapsed, msg, info)
+
+    def extra_info(self) -> dict[str, Any]:
+        """Controller-specific entries of ``PlanResult.info``."""
+        return {}
+
+    def success_message(self, steps: int) -> str:
+        return f"reached the goal in {steps} steps"
+
+    def failure_message(self, code: int, status: Status, path: np.ndarray, steps: int) -> str:
+        """A sentence for a run that did not reach the goal."""
+        x, y = path[-1]
+        gx, gy = self.problem.goal
+        where = f"at ({x:.3f}, {y:.3f}), {math.hypot(x - gx, y - gy):.3f} m from the goal"
+        if code == CODE_BLOCKED:
+            return f"blocked {where}: no collision-free move along the force"
+        if code == CODE_STALLED:
+            return (f"local minimum {where}: moved less than {self.stall_distance_m:g} m "
+                    f"over the last {self.params.stall_steps} steps")
+        if status is Status.MAX_ITERATIONS:
+            return f"step cap of {self.max_steps} steps reached {where}"
+        return f"time limit reached after {steps} steps, {where}"
+
+    # ------------------------------------------------------------------ online
+    def act(self, obs: Observed) -> np.ndarray:
+        """One move of the same loop as :meth:`run`, among the sensed discs."""
+        x = float(obs.position[0])
+        y = float(obs.position[1])
+        n0 = self.n
+        last = self.buf[n0 - 1]
+        if abs(last[0] - x) > 1e-9 or abs(last[1] - y) > 1e-9:
+            self.buf[n0 - 1] = (x, y)  # the world moved the robot elsewhere (clipped, pushed)
+        else:
+            x, y = float(last[0]), float(last[1])
+        sens = obs.obstacles
+        if len(sens):
+            discs = (_plain(sens.positions), _plain(sens.velocities), _plain(sens.radii))
+        else:
+            discs = _NO_DISCS
+        self.f[F_RVX] = float(obs.velocity[0])
+        self.f[F_RVY] = float(obs.velocity[1])
+        code, _ = self._call(1, *discs)
+        if code in (CODE_STALLED, CODE_BLOCKED):
+            self.on_stuck()
+        if self.n > n0:
+            nx, ny = float(self.buf[self.n - 1, 0]), float(self.buf[self.n - 1, 1])
+        else:
+            nx, ny = x, y
+        if self.params.dodge and len(sens) and code not in (CODE_GOAL, CODE_GOAL_SNAP) and \
+                math.hypot(nx - x, ny - y) < 0.5 * self.step_m:
+            d = self._dodge(sens, x, y, nx - x, ny - y)
+            if d is not None:
+                nx, ny = d
+        dt = float(self.dt)  # type: ignore[arg-type]
+        return np.array([(nx - x) / dt, (ny - y) / dt])
+
+    def on_stuck(self) -> None:
+        """Online: the loop stalled or was blocked and could not escape; keep going."""
+
+    def _dodge(self, sens: Any, x: float, y: float, fx: float,
+               fy: float) -> tuple[float, float] | None:
+        """A full clear move that most increases the predicted gap to the sensed discs.
+
+        Used when the controller's own move is (nearly) blocked while discs
+        are sensed (typically a disc pressing the robot against a wall).  The
+        discs are predicted one tick ahead at their current velocity; none of
+        the 12 directions (every 30 degrees, nearest to the intended move
+        first) is taken unless it beats standing still.
+        """
+        q = sens.positions + sens.velocities * float(self.dt)  # type: ignore[arg-type]
+        radii = sens.radii
+        g = self.problem.grid
+        ox, oy = g.origin
+        step = self.step_m
+
+        def gap(px: float, py: float) -> float:
+            return float((np.hypot(q[:, 0] - px, q[:, 1] - py) - radii).min())
+
+        best = gap(x, y)
+        best_xy = None
+        if fx == 0.0 and fy == 0.0:
+            gx, gy = self.problem.goal
+            fx, fy = gx - x, gy - y
+        a0 = math.atan2(fy, fx) if (fx or fy) else 0.0
+        for k in range(12):
+            a = a0 + math.pi / 6 * ((k + 1) // 2) * (1 if k % 2 else -1)
+            tx, ty = x + step * math.cos(a), y + step * math.sin(a)
+            if segment_is_clear(x, y, tx, ty, g.occupied, ox, oy, g.resolution, self.clear_m):
+                gp = gap(tx, ty)
+                if gp > best + 1e-9:
+                    best, best_xy = gp, (tx, ty)
+        return best_xy

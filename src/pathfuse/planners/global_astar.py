@@ -1,0 +1,226 @@
+"""The global planner: grid A* on the robot's c-space, one wrapper for every planner.
+
+:func:`plan_global` runs exact 8-connected A* (:mod:`pathfuse.search.astar`)
+on :meth:`GridMap.cspace` of the problem's robot radius (obstacles and the
+map's edge grown by the radius; the map itself for a point robot).
+
+* A point robot starts from the cell its start lies in.  A disc robot
+  starts from the nearest free c-space cell (within two cells) whose centre
+  it reaches in a clear straight move; the goal likewise.
+* :attr:`GlobalPlan.points` are the cell centres from the start cell to the
+  goal cell: the grid path, whose length is the A* cost
+  (:attr:`GlobalPlan.length_m`).  This is what the ``astar`` planner returns.
+* :attr:`GlobalPlan.waypoints` are what a controller follows:
+  ``[start, centres..., goal]``, the first and last centres left out when
+  the straight move past them is clear (on a query between cell centres the
+  waypoints equal the centres).
+
+Examples
+--------
+>>> from pathfuse.grid import GridMap
+>>> from pathfuse.problem import Problem
+>>> g = GridMap.from_rows(["....", ".##.", ".#.."])
+>>> gp = plan_global(Problem.create(g, (0.5, 0.5), (3.5, 2.5), robot_radius_m=0.2))
+>>> gp.status.name, gp.waypoints.tolist()
+('SUCCESS', [[0.5, 0.5], [0.5, 1.5], [0.5, 2.5], [1.5, 2.5], [2.5, 2.5], [3.5, 2.5]])
+>>> round(gp.length_m, 4), gp.expansions > 0
+(5.0, True)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pathfuse.field.motion import MARGIN_FRAC
+from pathfuse.geometry import segment_is_clear
+from pathfuse.grid import GridMap
+from pathfuse.problem import Problem
+from pathfuse.result import Status
+from pathfuse.search.astar import AStarSearcher, get_searcher
+
+__all__ = ["GlobalPlan", "plan_global", "route", "snap_cell"]
+
+_NO_POINTS = np.zeros((0, 2))
+_NO_POINTS.setflags(write=False)
+_NO_CELLS = np.zeros((0, 2), dtype=np.int64)
+_NO_CELLS.setflags(write=False)
+
+
+@dataclass(frozen=True, eq=False)
+class GlobalPlan:
+    """The outcome of :func:`plan_global`.
+
+    Attributes
+    ----------
+    status : Status
+        ``SUCCESS``, ``NO_PATH``, ``MAX_ITERATIONS``, ``TIMEOUT``, or
+        ``START_/GOAL_OCCUPIED`` when a disc robot finds no c-space cell to
+        start or end in.
+    cells : (N, 2) int array
+        ``(row, col)`` from the start cell to the goal cell.
+    points : (N, 2) float array
+        Their centres (metres).
+    waypoints : (M, 2) float array
+        What a controller follows: the start, the centres, the goal.
+    length_m : float
+        The A* cost in metres (the length of ``points``).
+    expansions : int
+    time_s : float
+        Time of the search itself (per-map buffers and numba compilation
+        are prepared before the clock starts).
+    message : str
+    heuristic : str
+    corner_cutting : bool
+    """
+
+    status: Status
+    cells: np.ndarray = field(default_factory=lambda: _NO_CELLS)
+    points: np.ndarray = field(default_factory=lambda: _NO_POINTS)
+    waypoints: np.ndarray = field(default_factory=lambda: _NO_POINTS)
+    length_m: float = math.inf
+    expansions: int = 0
+    time_s: float = 0.0
+    message: str = ""
+    heuristic: str = "euclidean"
+    corner_cutting: bool = False
+
+    @property
+    def success(self) -> bool:
+        return self.status is Status.SUCCESS
+
+
+def snap_cell(occ: np.ndarray, grid: GridMap, p: tuple[float, float],
+              r: float) -> tuple[int, int] | None:
+    """A free cell of ``occ`` near ``p`` whose centre a disc of radius ``r`` reaches in a
+    clear straight move (nearest first, within two cells); None if there is none."""
+    res = grid.resolution
+    ox, oy = grid.origin
+    c = math.floor((p[0] - ox) / res)
+    rr = math.floor((p[1] - oy) / res)
+    h, w = occ.shape
+    cands = []
+    for dr in range(-2, 3):
+        for dc in range(-2, 3):
+            r2, c2 = rr + dr, c + dc
+            if 0 <= r2 < h and 0 <= c2 < w and not occ[r2, c2]:
+                cx = ox + (c2 + 0.5) * res
+                cy = oy + (r2 + 0.5) * res
+                cands.append((math.hypot(cx - p[0], cy - p[1]), r2, c2, cx, cy))
+    cands.sort(key=lambda t: (t[0], t[1], t[2]))
+    for _, r2, c2, cx, cy in cands:
+        if segment_is_clear(p[0], p[1], cx, cy, grid.occupied, ox, oy, res, r):
+            return (r2, c2)
+    return None
+
+
+def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: bool = False,
+                occupied: np.ndarray | None = None, max_expansions: int | None = None,
+                time_limit_s: float | None = None) -> GlobalPlan:
+    """Grid A* for ``problem`` (its start and goal must be free: :meth:`Problem.failure`).
+
+    Parameters
+    ----------
+    problem : Problem
+    heuristic : {"euclidean", "octile"}
+    corner_cutting : bool
+        Allow a diagonal move past a blocked orthogonal neighbour (the path
+        then grazes obstacle corners).
+    occupied : (H, W) bool array, optional
+        A c-space of the map's shape to search instead (a replanner's, with
+        moving discs rasterised into it).
+    max_expansions : int, optional
+        Stop with ``MAX_ITERATIONS`` after this many expansions (default: no
+        cap beyond the number of free cells).
+    time_limit_s : float, optional
+        Default: the problem's budget.
+    """
+    grid = problem.grid
+    r = problem.robot_radius_m
+    cs = grid.cspace(r)
+    occ = cs.occupied if occupied is None else occupied
+    if r > 0 or occupied is not None:
+        sc = snap_cell(occ, grid, problem.start, r)
+        gc = snap_cell(occ, grid, problem.goal, r)
+        if sc is None or gc is None:
+            what = "start" if sc is None else "goal"
+            status = Status.START_OCCUPIED if sc is None else Status.GOAL_OCCUPIED
+            return GlobalPlan(status, message=f"no free cell near the {what} that the robot "
+                              f"(radius {r:g} m) can reach in a straight line",
+                              heuristic=heuristic, corner_cutting=corner_cutting)
+    else:
+        sc, gc = problem.start_cell, problem.goal_cell
+    if occupied is None:
+        searcher = get_searcher(cs, corner_cutting=corner_cutting)
+    else:
+        searcher = AStarSearcher(occ, corner_cutting=corner_cutting)
+    budget = problem.budget
+    limit = budget.time_limit_s if time_limit_s is None else time_limit_s
+    t0 = time.perf_counter()
+    res = searcher.search(sc, gc, heuristic=heuristic, max_expansions=max_expansions,
+                          time_limit_s=limit)
+    elapsed = time.perf_counter() - t0
+    if res.status is not Status.SUCCESS:
+        if res.status is Status.NO_PATH:
+            msg = ("goal is not reachable from start (different connected free regions)"
+                   if res.expansions == 0
+                   else f"goal is not reachable from start ({res.expansions} expansions)")
+        elif res.status is Status.MAX_ITERATIONS:
+            msg = f"stopped after {res.expansions} expansions (max_iterations)"
+        else:
+            msg = (f"stopped after {elapsed:.3g} s > time_limit_s={limit:g} "
+                   f"({res.expansions} expansions)")
+        return GlobalPlan(res.status, expansions=res.expansions, time_s=elapsed, message=msg,
+                          heuristic=heuristic, corner_cutting=corner_cutting)
+    points = grid.cell_to_world(res.cells)
+    return GlobalPlan(Status.SUCCESS, res.cells, points, _waypoints(problem, points),
+                      res.cost * grid.resolution, res.expansions, elapsed,
+                      f"path through {len(res.cells)} cells, {res.cost * grid.resolution:.6g} m, "
+                      f"{res.expansions} expansions", heuristic, corner_cutting)
+
+
+def _waypoints(problem: Problem, centres: np.ndarray) -> np.ndarray:
+    """``[start, centres..., goal]``, leaving out the first and last centres when the straight
+    move past them is clear, and repeated points."""
+    grid = problem.grid
+    ox, oy = grid.origin
+    occ = grid.occupied
+    res = grid.resolution
+    clear = problem.robot_radius_m + MARGIN_FRAC * res
+    (sx, sy), (gx, gy) = problem.start, problem.goal
+    i0 = 0
+    n = centres.shape[0]
+    if n > 1 and segment_is_clear(sx, sy, centres[1, 0], centres[1, 1], occ, ox, oy, res, clear):
+        i0 = 1
+    i1 = n
+    if i1 - i0 > 1 and segment_is_clear(centres[i1 - 2, 0], centres[i1 - 2, 1], gx, gy, occ, ox,
+                                        oy, res, clear):
+        i1 -= 1
+    path = np.empty((i1 - i0 + 2, 2))
+    path[0] = problem.start
+    path[1:-1] = centres[i0:i1]
+    path[-1] = problem.goal
+    keep = np.ones(path.shape[0], dtype=bool)
+    keep[1:] = np.any(np.diff(path, axis=0) != 0.0, axis=1)
+    return np.ascontiguousarray(path[keep])
+
+
+def route(grid: GridMap, start: object, goal: object, robot_radius_m: float = 0.0,
+          heuristic: str = "euclidean") -> np.ndarray | None:
+    """The waypoints a controller would follow from ``start`` to ``goal``, or None when
+    the start or goal is blocked or A* finds no path.
+
+    >>> g = GridMap.from_rows(["....", ".##.", "...."])
+    >>> route(g, (0.5, 0.5), (3.5, 2.5)).tolist()
+    [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
+    >>> route(g, (0.5, 0.5), (1.5, 1.5)) is None   # the goal lies in an obstacle
+    True
+    """
+    problem = Problem.create(grid, start, goal, robot_radius_m)
+    if problem.failure() is not None:
+        return None
+    gp = plan_global(problem, heuristic)
+    return gp.waypoints if gp.success else None

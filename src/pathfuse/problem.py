@@ -1,0 +1,185 @@
+"""A planning problem, validated once: the map, the start, the goal, the robot radius, the budget.
+
+:meth:`Problem.create` checks the input (a bad value is a
+:class:`~pathfuse.result.QueryError` or :class:`~pathfuse.result.ConfigError`
+naming it) and fixes the start and goal cells with scalar arithmetic, so
+the planners trust a problem and never check it again.  Whether the start
+and the goal can be planned from at all (inside the map, not blocked) is an
+*outcome*, not bad input: :meth:`Problem.failure` gives the status.
+
+Examples
+--------
+>>> from pathfuse.grid import GridMap
+>>> g = GridMap.from_rows(["....", ".##.", "...."])
+>>> p = Problem.create(g, (0.5, 0.5), (3.5, 2.5))
+>>> p.start_cell, p.goal_cell, p.failure()
+((0, 0), (2, 3), None)
+>>> Problem.create(g, (1.5, 1.5), (3.5, 2.5)).failure()[0].name
+'START_OCCUPIED'
+>>> status, message = Problem.create(g, (0.5, 0.5), (9.0, 0.5)).failure()
+>>> status.name, message
+('GOAL_OUT_OF_BOUNDS', 'goal (9, 0.5) is outside the map [0, 4) x [0, 3)')
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from pathfuse.grid import GridMap
+from pathfuse.result import Budget, ConfigError, QueryError, Status
+
+__all__ = ["Problem", "as_xy"]
+
+_DEFAULT_BUDGET = Budget()
+
+
+def as_xy(value: object, what: str) -> tuple[float, float]:
+    """A finite ``(x, y)`` pair of floats, or :class:`QueryError` naming ``what``.
+
+    >>> as_xy((1, 2.5), "start")
+    (1.0, 2.5)
+    >>> as_xy("12", "goal")
+    Traceback (most recent call last):
+    ...
+    pathfuse.result.QueryError: goal: must be two numbers (x, y), got '12'
+    """
+    if isinstance(value, (str, bytes)):
+        raise QueryError(f"{what}: must be two numbers (x, y), got {value!r}")
+    try:
+        x, y = value  # type: ignore[misc]
+        x = float(x)
+        y = float(y)
+    except (TypeError, ValueError, OverflowError):
+        shown = repr(value)
+        shown = shown if len(shown) <= 60 else shown[:57] + "..."
+        raise QueryError(f"{what}: must be two numbers (x, y), got {shown}") from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise QueryError(f"{what}: must be finite, got {value!r}")
+    return x, y
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """A planning query that planners trust (build it with :meth:`create`).
+
+    Attributes
+    ----------
+    grid : GridMap
+        The static map.
+    start, goal : (float, float)
+        World coordinates in metres.
+    robot_radius_m : float
+        Radius of the disc robot (0: a point).  Planners keep this clearance
+        from every occupied square and from the map's edge; the global
+        planner searches :meth:`GridMap.cspace`.
+    budget : Budget
+        Iteration and time caps.
+    start_cell, goal_cell : (int, int)
+        ``(row, col)`` of the cells the points lie in (may be outside the
+        map: see :meth:`failure`).
+    """
+
+    grid: GridMap
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    robot_radius_m: float = 0.0
+    budget: Budget = field(default=_DEFAULT_BUDGET)
+    start_cell: tuple[int, int] = (0, 0)
+    goal_cell: tuple[int, int] = (0, 0)
+
+    @classmethod
+    def create(cls, grid: GridMap, start: object, goal: object, robot_radius_m: float = 0.0,
+               budget: Budget | None = None) -> Problem:
+        """Check the input once and fix the cells (scalar arithmetic, no numpy per point).
+
+        Raises
+        ------
+        QueryError
+            ``grid`` is not a :class:`GridMap`, or ``start``/``goal`` is not a
+            pair of finite numbers.
+        ConfigError
+            ``robot_radius_m`` is not a finite number >= 0, or ``budget`` is
+            not a :class:`Budget`.
+        """
+        if not isinstance(grid, GridMap):
+            raise QueryError(f"grid: must be a pathfuse.GridMap, got {type(grid).__name__}")
+        s = as_xy(start, "start")
+        g = as_xy(goal, "goal")
+        if budget is None:
+            budget = _DEFAULT_BUDGET
+        elif not isinstance(budget, Budget):
+            raise ConfigError(f"budget: must be a pathfuse.Budget, got {type(budget).__name__}")
+        r = robot_radius_m
+        if isinstance(r, bool) or not isinstance(r, (int, float)) or not math.isfinite(r) \
+                or r < 0:
+            try:
+                r = float(r)  # numpy scalars
+                ok = math.isfinite(r) and r >= 0
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise ConfigError(
+                    f"robot_radius_m: must be a finite number >= 0, got {robot_radius_m!r}")
+        ox, oy = grid.origin
+        res = grid.resolution
+        return cls(grid, s, g, float(r), budget,
+                   (math.floor((s[1] - oy) / res), math.floor((s[0] - ox) / res)),
+                   (math.floor((g[1] - oy) / res), math.floor((g[0] - ox) / res)))
+
+    def failure(self) -> tuple[Status, str] | None:
+        """``(status, message)`` when the start or goal cannot be planned from, else None.
+
+        Out of the map: ``START_/GOAL_OUT_OF_BOUNDS``.  Blocked: a point robot
+        in an occupied (or, on a ROS map, unknown) cell, or a disc robot that
+        overlaps an occupied square or the map's edge:
+        ``START_/GOAL_OCCUPIED``.
+        """
+        for p, cell, what, oob, occ in (
+            (self.start, self.start_cell, "start", Status.START_OUT_OF_BOUNDS,
+             Status.START_OCCUPIED),
+            (self.goal, self.goal_cell, "goal", Status.GOAL_OUT_OF_BOUNDS, Status.GOAL_OCCUPIED),
+        ):
+            g = self.grid
+            r, c = cell
+            if not (0 <= r < g.height and 0 <= c < g.width):
+                x0, y0, x1, y1 = g.bounds
+                return oob, (f"{what} ({p[0]:g}, {p[1]:g}) is outside the map "
+                             f"[{x0:g}, {x1:g}) x [{y0:g}, {y1:g})")
+            msg = self._blocked(p, cell, what)
+            if msg is not None:
+                return occ, msg
+        return None
+
+    def _blocked(self, p: tuple[float, float], cell: tuple[int, int], what: str) -> str | None:
+        g = self.grid
+        r, c = cell
+        if g.occupied[r, c]:
+            unknown = g.meta.get("unknown")
+            if unknown is not None and bool(unknown[r, c]):
+                return (f"{what} ({p[0]:g}, {p[1]:g}) lies in an unknown cell of the map "
+                        "(unknown cells are blocked; load the map with unknown='free' to "
+                        "plan through them)")
+            return f"{what} ({p[0]:g}, {p[1]:g}) lies in an occupied cell"
+        if self.robot_radius_m > 0:
+            from pathfuse.geometry import segment_is_clear
+
+            ox, oy = g.origin
+            from pathfuse.field.motion import MARGIN_FRAC
+
+            # the clearance every controller keeps (the radius plus a sliver), so that a
+            # robot allowed to start or stop here can also move away or arrive
+            clear = self.robot_radius_m + MARGIN_FRAC * g.resolution
+            if not segment_is_clear(p[0], p[1], p[0], p[1], g.occupied, ox, oy, g.resolution,
+                                    clear):
+                return (f"{what} ({p[0]:g}, {p[1]:g}): the robot (radius "
+                        f"{self.robot_radius_m:g} m) overlaps an occupied cell or the map's edge")
+        return None
+
+    def with_start(self, start: tuple[float, float]) -> Problem:
+        """The same problem from another start (a replanning robot's position)."""
+        ox, oy = self.grid.origin
+        res = self.grid.resolution
+        return Problem(self.grid, start, self.goal, self.robot_radius_m, self.budget,
+                       (math.floor((start[1] - oy) / res), math.floor((start[0] - ox) / res)),
+                       self.goal_cell)

@@ -22,7 +22,9 @@ def _warm() -> None:
     except Exception:  # noqa: BLE001 - best effort only
         pass
     try:
-        import pathfuse.metrics  # noqa: F401
+        from pathfuse.metrics_kernels import warmup as warmup_metrics
+
+        warmup_metrics()
     except Exception:  # noqa: BLE001
         pass
     try:  # the dynamic world's kernels (online planners, geometry, moving discs)

@@ -9,7 +9,8 @@ path is the polyline through its points.
   (:mod:`pathfuse.metrics_kernels`) with an exact segment-to-square distance
   (a slab intersection test, then the vertex-to-edge distances of the two
   convex shapes), visiting only the cells in rings around the segment up to
-  the ring that provably cannot hold a closer square.
+  the ring that provably cannot hold a closer square, and beyond a few rings
+  the blocks of an occupancy pyramid (built once per map) that can.
 * :func:`collision_free` -- every point inside the map rectangle and, for a
   point robot (``robot_radius_m == 0``), no contact with any occupied square:
   touching counts, so a diagonal that squeezes through the shared corner of
@@ -43,12 +44,14 @@ False
 from __future__ import annotations
 
 import math
+import weakref
 from typing import Any
 
 import numpy as np
 
 from pathfuse.grid import GridMap
 from pathfuse.metrics_kernels import (
+    build_pyramid,
     evaluate_kernel,
     geometry_kernel,
     segment_clearances_kernel,
@@ -67,6 +70,19 @@ __all__ = [
     "r_ratio",
     "evaluate",
 ]
+
+
+# occupancy pyramid of each map (pathfuse.metrics_kernels.build_pyramid), built on first use
+_PYRAMIDS: weakref.WeakKeyDictionary[GridMap, tuple[np.ndarray, np.ndarray]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def _pyramid(grid: GridMap) -> tuple[np.ndarray, np.ndarray]:
+    entry = _PYRAMIDS.get(grid)
+    if entry is None:
+        entry = _PYRAMIDS[grid] = build_pyramid(grid.occupied)
+    return entry
 
 
 def _path(path: object) -> np.ndarray:
@@ -122,8 +138,8 @@ def smoothness(path: object) -> float:
 def _geometry(grid: GridMap, p: np.ndarray) -> tuple[float, bool]:
     """(min clearance, in bounds) of a validated non-empty path, in one pass."""
     x0, y0, x1, y1 = grid.bounds
-    c, inside = geometry_kernel(grid.occupied, grid.origin[0], grid.origin[1], grid.resolution,
-                                x0, y0, x1, y1, np.ascontiguousarray(p))
+    c, inside = geometry_kernel(grid.occupied, *_pyramid(grid), grid.origin[0], grid.origin[1],
+                                grid.resolution, x0, y0, x1, y1, np.ascontiguousarray(p))
     return float(c), bool(inside)
 
 
@@ -154,8 +170,8 @@ def segment_clearances(grid: GridMap, path: object) -> np.ndarray:
     p = _path(path)
     if p.shape[0] == 0:
         return np.zeros(0)
-    return segment_clearances_kernel(grid.occupied, grid.origin[0], grid.origin[1],
-                                     grid.resolution, np.ascontiguousarray(p))
+    return segment_clearances_kernel(grid.occupied, *_pyramid(grid), grid.origin[0],
+                                     grid.origin[1], grid.resolution, np.ascontiguousarray(p))
 
 
 def min_clearance(grid: GridMap, path: object) -> float:
@@ -240,8 +256,8 @@ def evaluate(grid: GridMap, result: PlanResult, robot_radius_m: float = 0.0) -> 
         # segment lengths and turns
         x0, y0, x1, y1 = grid.bounds
         clearance, inside, lengths, turns = evaluate_kernel(
-            grid.occupied, grid.origin[0], grid.origin[1], grid.resolution, x0, y0, x1, y1,
-            np.ascontiguousarray(p))
+            grid.occupied, *_pyramid(grid), grid.origin[0], grid.origin[1], grid.resolution,
+            x0, y0, x1, y1, np.ascontiguousarray(p))
         clearance, inside = float(clearance), bool(inside)
         length, turn = float(lengths.sum()), float(turns.sum())
     else:

@@ -10,33 +10,32 @@ Geometry: the obstacles are the closed occupied cell squares; cell
 ``(r, c)`` is ``[ox + c * res, ox + (c + 1) * res] x [oy + r * res, oy + (r + 1) * res]``,
 its bounds computed exactly as the previous (k-d tree) implementation did,
 from the cell centre plus or minus half a cell, so that the distances agree
-bit for bit.
+bit for bit.  A square is measured with the exact segment-to-closed-square
+distance: zero if the segment meets it (a Liang-Barsky slab test), otherwise
+the least of the distances from the segment's end points to the square and
+from the square's corners to the segment.
 
-Search: for each segment, rings of cells are visited around the segment's
-bounding box of cells, nearest ring first.  Every point of a cell in ring
-``k >= 1`` is at least ``(k - 1 + m) * res`` from the segment (``k - 1``
-whole cells lie between it and the box, and the segment lies at least ``m``
-cells inside the box), so once the best distance found is below
-``(k + m) * res`` no unvisited cell can be closer and the search stops.  Only
-occupied cells are measured, with the exact segment-to-closed-square
-distance: zero if the segment meets the square (a Liang-Barsky slab test),
-otherwise the least of the distances from the segment's end points to the
-square and from the square's corners to the segment.
+Search, per segment (the answer is the same whichever way it is found):
 
-* The best distance starts at the distance to one occupied square (any
-  square's distance bounds the minimum), and only the part of the segment
-  within that distance of the map rectangle is searched.
-* A long segment is cut into pieces (the first 4 cells long, the next ones
-  about twice the best distance so far), each searched the same way (the
-  distance measured is always that of the whole segment), so the cells
-  visited stay within a band around the segment rather than its whole
-  bounding box.
-* Along a path, each segment's search is also cut short by the least
-  clearance of the segments before it when only the minimum is wanted
-  (:func:`geometry_kernel`).
-* A segment with an end point more than ``4 * max(H, W) + 64`` cells outside
-  the map is measured against every occupied square instead (no planner
-  makes one; this bounds the ring count and keeps cell indices small).
+1. *Rings* (short segments in or near the map, the common case): rings of
+   cells around the segment's box of cells, nearest first.  Every point of a
+   cell in ring ``k >= 1`` is at least ``(k - 1 + m) * res`` from the segment
+   (``k - 1`` whole cells lie between it and the box, and the segment lies at
+   least ``m`` cells inside the box), so once the best distance found is
+   below ``(k + m) * res`` no unvisited cell can be closer and the search
+   stops.  At most :data:`_MAX_RINGS` rings are visited.
+2. *Pyramid* (what rings did not settle: large clearance, long segments,
+   segments far outside the map): branch and bound over an occupancy pyramid
+   (level ``l`` block = ``2**l x 2**l`` cells, marked if any cell in it is
+   occupied; built once per map by :func:`build_pyramid`).  Blocks are
+   visited depth first, nearest first; an empty block, or one whose
+   rectangle is no nearer than the best distance so far, is skipped with
+   everything in it.  The cost grows with the number of blocks near the
+   answer, not with the area around the segment.
+
+Along a path, when only the minimum is wanted (:func:`geometry_kernel`), each
+segment's search also starts from the least clearance of the segments before
+it, which prunes both searches.
 """
 
 from __future__ import annotations
@@ -47,6 +46,7 @@ import numpy as np
 from numba import njit
 
 __all__ = [
+    "build_pyramid",
     "segment_clearances_kernel",
     "geometry_kernel",
     "shape_kernel",
@@ -54,11 +54,13 @@ __all__ = [
     "warmup",
 ]
 
-# window margin, in cells: guards the floor() of the piece bounds and the stop test
+# window margin, in cells: guards the floor() of the segment's box and the stop test
 # against rounding of the world -> cell conversion
 _EPS_CELLS = 1e-6
-# shortest piece a long segment is cut into, in cells
-_MIN_PIECE_CELLS = 4.0
+# segments longer than this (in cells, |du| + |dv|) go straight to the pyramid
+_SHORT_CELLS = 4.0
+# rings visited before the pyramid takes over
+_MAX_RINGS = 4
 
 
 @njit(cache=True, inline="always")
@@ -156,112 +158,175 @@ def _scan_rows(occ, r0, r1, c0, c1, ax, ay, bx, by, sx0, sy0, sx1, sy1, ox, oy, 
 
 
 @njit(cache=True)
-def _brute(occ, ox, oy, res, h, ax, ay, bx, by, best):
-    """min(best, distance of AB to every occupied square): the fallback for far segments."""
+def build_pyramid(occ):
+    """Occupancy pyramid of ``occ``: (flat uint8 levels 1..L, (L, 3) int64 [offset, h, w]).
+
+    Level ``l`` holds ``ceil(H / 2**l) x ceil(W / 2**l)`` blocks, block
+    ``(i, j)`` = 1 when any cell of rows ``i * 2**l ..`` and columns ``j * 2**l ..``
+    is occupied.  The last level has one block (none for a 1 x 1 map).
+    """
     hgt, wid = occ.shape
-    return _scan_rows(occ, 0, hgt - 1, 0, wid - 1, ax, ay, bx, by, min(ax, bx), min(ay, by),
-                      max(ax, bx), max(ay, by), ox, oy, res, h, best)
+    nlev = 0
+    total = 0
+    h, w = hgt, wid
+    while h > 1 or w > 1:
+        h = (h + 1) // 2
+        w = (w + 1) // 2
+        nlev += 1
+        total += h * w
+    meta = np.zeros((nlev, 3), dtype=np.int64)
+    pyr = np.zeros(total, dtype=np.uint8)
+    h, w = hgt, wid
+    off = 0
+    for lev in range(nlev):
+        ph, pw = h, w
+        h = (h + 1) // 2
+        w = (w + 1) // 2
+        meta[lev, 0] = off
+        meta[lev, 1] = h
+        meta[lev, 2] = w
+        poff = meta[lev - 1, 0] if lev > 0 else 0
+        for i in range(ph):
+            for j in range(pw):
+                if lev == 0:
+                    full = occ[i, j]
+                else:
+                    full = pyr[poff + i * pw + j] != 0
+                if full:
+                    pyr[off + (i // 2) * w + j // 2] = 1
+        off += h * w
+    return pyr, meta
 
 
 @njit(cache=True, inline="always")
-def _clip(u0, v0, u1, v1, lo_u, lo_v, hi_u, hi_v):
-    """Parameter interval [t0, t1] of segment (u0, v0)-(u1, v1) inside a box (t0 > t1: none)."""
-    t0 = 0.0
-    t1 = 1.0
-    d = u1 - u0
-    if d == 0:
-        if u0 < lo_u or u0 > hi_u:
-            return 1.0, 0.0
-    else:
-        ta = (lo_u - u0) / d
-        tb = (hi_u - u0) / d
-        t0 = max(t0, min(ta, tb))
-        t1 = min(t1, max(ta, tb))
-    d = v1 - v0
-    if d == 0:
-        if v0 < lo_v or v0 > hi_v:
-            return 1.0, 0.0
-    else:
-        ta = (lo_v - v0) / d
-        tb = (hi_v - v0) / d
-        t0 = max(t0, min(ta, tb))
-        t1 = min(t1, max(ta, tb))
-    return t0, t1
+def _block_full(occ, pyr, meta, lev, i, j):
+    if lev == 0:
+        return occ[i, j]
+    m = meta[lev - 1]
+    return pyr[m[0] + i * m[2] + j] != 0
 
 
 @njit(cache=True)
-def _segment_clearance(occ, ox, oy, res, ax, ay, bx, by, best, seed_r, seed_c):
-    """min(best, exact distance from segment AB to the nearest occupied square).
-
-    ``(seed_r, seed_c)`` is any occupied cell; ``best = inf`` gives the
-    segment's own clearance, a finite ``best`` (the least clearance found so
-    far on a path) only prunes the search.
-    """
+def _pyramid_search(occ, pyr, meta, ox, oy, res, ax, ay, bx, by, best, ws):
+    """min(best, exact distance from AB to every occupied square), by branch and bound."""
+    stack, stack_lb, cl, cij = ws
     hgt, wid = occ.shape
     h = res / 2
+    nlev = meta.shape[0]
     sx0 = min(ax, bx)
     sx1 = max(ax, bx)
     sy0 = min(ay, by)
     sy1 = max(ay, by)
-    if best == math.inf:
-        # the seed square bounds the answer, so the parts of AB farther than that from
-        # the map rectangle can be skipped
-        cx = ox + (seed_c + 0.5) * res
-        cy = oy + (seed_r + 0.5) * res
-        best = _seg_box(ax, ay, bx, by, cx - h, cy - h, cx + h, cy + h)
-    if best == 0.0:
-        return 0.0
-    # cell coordinates (cell (r, c) is [c, c + 1] x [r, r + 1])
+    if nlev == 0:  # a 1 x 1 map
+        return _cell_dist(occ, 0, 0, ax, ay, bx, by, sx0, sy0, sx1, sy1, ox, oy, res, h, best)
+    # block rectangles are grown by eps so that their distance never exceeds, by
+    # rounding, that of a square inside them
+    eps = 1e-6 * res + 1e-12 * (abs(ox) + abs(oy) + (hgt + wid) * res)
+    if not _block_full(occ, pyr, meta, nlev, 0, 0):
+        return best
+    n = 1
+    stack[0, 0] = nlev
+    stack[0, 1] = 0
+    stack[0, 2] = 0
+    stack_lb[0] = 0.0
+    while n > 0:
+        n -= 1
+        if stack_lb[n] >= best:
+            continue  # best improved since this block was pushed
+        lev = stack[n, 0]
+        i = stack[n, 1]
+        j = stack[n, 2]
+        # children: level lev - 1, blocks (2i .. 2i + 1, 2j .. 2j + 1) within that level
+        clev = lev - 1
+        if clev == 0:
+            ch, cw = hgt, wid
+        else:
+            ch = meta[clev - 1, 1]
+            cw = meta[clev - 1, 2]
+        size = 1 << clev  # cells per child block side
+        k = 0
+        for ii in range(2 * i, min(2 * i + 2, ch)):
+            for jj in range(2 * j, min(2 * j + 2, cw)):
+                if not _block_full(occ, pyr, meta, clev, ii, jj):
+                    continue
+                if clev == 0:
+                    best = _cell_dist(occ, ii, jj, ax, ay, bx, by, sx0, sy0, sx1, sy1,
+                                      ox, oy, res, h, best)
+                    if best == 0.0:
+                        return 0.0
+                    continue
+                x0 = ox + (jj * size) * res - eps
+                x1 = ox + (min((jj + 1) * size, wid)) * res + eps
+                y0 = oy + (ii * size) * res - eps
+                y1 = oy + (min((ii + 1) * size, hgt)) * res + eps
+                gx = max(max(x0 - sx1, sx0 - x1), 0.0)
+                gy = max(max(y0 - sy1, sy0 - y1), 0.0)
+                if gx * gx + gy * gy >= best * best:
+                    continue  # even the boxes are too far apart
+                lb = _seg_box(ax, ay, bx, by, x0, y0, x1, y1)
+                if lb >= best:
+                    continue
+                # insert, keeping cl descending: the nearest child is pushed last
+                p = k
+                while p > 0 and cl[p - 1] < lb:
+                    cl[p] = cl[p - 1]
+                    cij[p, 0] = cij[p - 1, 0]
+                    cij[p, 1] = cij[p - 1, 1]
+                    p -= 1
+                cl[p] = lb
+                cij[p, 0] = ii
+                cij[p, 1] = jj
+                k += 1
+        for q in range(k):
+            stack[n, 0] = clev
+            stack[n, 1] = cij[q, 0]
+            stack[n, 2] = cij[q, 1]
+            stack_lb[n] = cl[q]
+            n += 1
+    return best
+
+
+@njit(cache=True)
+def _ring_search(occ, ox, oy, res, ax, ay, bx, by, best):
+    """(min(best, distance from AB to the occupied squares nearby), whether that is final).
+
+    Final: no square beyond the rings visited can be nearer.  Not final for
+    long segments, segments far outside the map, and when :data:`_MAX_RINGS`
+    rings did not settle it; the pyramid search must then finish the job
+    (the ``best`` returned is still a valid start for it).
+    """
+    hgt, wid = occ.shape
     ua = (ax - ox) / res
     va = (ay - oy) / res
     ub = (bx - ox) / res
     vb = (by - oy) / res
-    far = 4.0 * max(hgt, wid) + 64.0
-    if (min(ua, ub) < -far or max(ua, ub) > wid + far or min(va, vb) < -far
-            or max(va, vb) > hgt + far):
-        return _brute(occ, ox, oy, res, h, ax, ay, bx, by, best)
-    short = abs(ub - ua) + abs(vb - va) <= _MIN_PIECE_CELLS  # one piece, whatever best is
-    length = 0.0 if short else math.hypot(ub - ua, vb - va)
-    first = True
-    t_lo = 0.0
-    while True:
-        # only the part of AB within best of the map rectangle can get closer
-        g = best / res + 1.0
-        if (min(ua, ub) >= -g and max(ua, ub) <= wid + g and min(va, vb) >= -g
-                and max(va, vb) <= hgt + g):
-            t_in, t_out = 0.0, 1.0
-        else:
-            t_in, t_out = _clip(ua, va, ub, vb, -g, -g, wid + g, hgt + g)
-        if t_in > t_out or t_lo > t_out:
-            break
-        t_lo = max(t_lo, t_in)
-        # the next piece [t_lo, t_hi] of AB, about twice the best distance long
-        piece = _MIN_PIECE_CELLS if first else max(_MIN_PIECE_CELLS, 2.0 * best / res)
-        first = False
-        if short or t_lo + piece / length >= t_out:
-            t_hi = t_out
-        else:
-            t_hi = t_lo + piece / length
-        pu0 = ua + t_lo * (ub - ua) if t_lo > 0.0 else ua
-        pv0 = va + t_lo * (vb - va) if t_lo > 0.0 else va
-        pu1 = ua + t_hi * (ub - ua) if t_hi < 1.0 else ub
-        pv1 = va + t_hi * (vb - va) if t_hi < 1.0 else vb
-        c0 = int(math.floor(min(pu0, pu1) - _EPS_CELLS))
-        c1 = int(math.floor(max(pu0, pu1) + _EPS_CELLS))
-        r0 = int(math.floor(min(pv0, pv1) - _EPS_CELLS))
-        r1 = int(math.floor(max(pv0, pv1) + _EPS_CELLS))
-        # margin of the piece inside its box of cells: ring k >= 1 is >= k - 1 + margin away
-        margin = min(min(pu0, pu1) - c0, c1 + 1 - max(pu0, pu1), min(pv0, pv1) - r0,
-                     r1 + 1 - max(pv0, pv1)) - _EPS_CELLS
+    lim = _MAX_RINGS + 1.0
+    if (abs(ub - ua) + abs(vb - va) <= _SHORT_CELLS and min(ua, ub) > -lim
+            and max(ua, ub) < wid + lim and min(va, vb) > -lim and max(va, vb) < hgt + lim):
+        h = res / 2
+        sx0 = min(ax, bx)
+        sx1 = max(ax, bx)
+        sy0 = min(ay, by)
+        sy1 = max(ay, by)
+        c0 = int(math.floor(min(ua, ub) - _EPS_CELLS))
+        c1 = int(math.floor(max(ua, ub) + _EPS_CELLS))
+        r0 = int(math.floor(min(va, vb) - _EPS_CELLS))
+        r1 = int(math.floor(max(va, vb) + _EPS_CELLS))
+        # margin of the segment inside its box of cells: ring k >= 1 is >= k - 1 + margin away
+        margin = min(min(ua, ub) - c0, c1 + 1 - max(ua, ub), min(va, vb) - r0,
+                     r1 + 1 - max(va, vb)) - _EPS_CELLS
         # rings 0 .. k-1 lie outside the map: start with the whole box grown by k
         k = max(0, r0 - (hgt - 1), -r1, c0 - (wid - 1), -c1)
         best = _scan_rows(occ, r0 - k, r1 + k, c0 - k, c1 + k, ax, ay, bx, by,
                           sx0, sy0, sx1, sy1, ox, oy, res, h, best)
-        while best > 0.0:
+        while True:
             if best < (k + margin) * res:
-                break  # every cell of ring k + 1 and beyond is >= (k + margin) * res away
+                # every cell of ring k + 1 and beyond is >= (k + margin) * res away
+                return best, True
             if r0 - k <= 0 and c0 - k <= 0 and r1 + k >= hgt - 1 and c1 + k >= wid - 1:
-                break  # the whole map has been visited
+                return best, True  # the whole map has been visited
+            if k >= _MAX_RINGS:
+                break  # not settled nearby: the pyramid takes over
             k += 1
             # ring k: bottom and top rows, then the left and right columns between them
             best = _scan_rows(occ, r0 - k, r0 - k, c0 - k, c1 + k, ax, ay, bx, by,
@@ -272,44 +337,41 @@ def _segment_clearance(occ, ox, oy, res, ax, ay, bx, by, best, seed_r, seed_c):
                               sx0, sy0, sx1, sy1, ox, oy, res, h, best)
             best = _scan_rows(occ, r0 - k + 1, r1 + k - 1, c1 + k, c1 + k, ax, ay, bx, by,
                               sx0, sy0, sx1, sy1, ox, oy, res, h, best)
-        if best == 0.0 or t_hi >= t_out:
-            break
-        t_lo = t_hi
-    return best
+    return best, False
 
 
 @njit(cache=True)
-def _first_obstacle(occ):
-    """(row, col) of one occupied cell, (-1, -1) if there is none."""
-    hgt, wid = occ.shape
-    for r in range(hgt):
-        for c in range(wid):
-            if occ[r, c]:
-                return r, c
-    return -1, -1
+def _workspace(meta):
+    """Buffers of the pyramid search: its stack (at most 3 blocks per level pending at
+    once, plus one) with the blocks' distances, and room to sort 4 children."""
+    cap = 4 * (meta.shape[0] + 2)
+    return (np.empty((cap, 3), dtype=np.int64), np.empty(cap), np.empty(4),
+            np.empty((4, 2), dtype=np.int64))
 
 
 @njit(cache=True)
-def segment_clearances_kernel(occ, ox, oy, res, p):
+def segment_clearances_kernel(occ, pyr, meta, ox, oy, res, p):
     """Per-segment clearance of the (N, 2) path ``p`` (N >= 1); one value for one point."""
     n = p.shape[0]
     m = max(n - 1, 1)
     out = np.full(m, np.inf)
-    sr, sc = _first_obstacle(occ)
-    if sr < 0:
+    if not _block_full(occ, pyr, meta, meta.shape[0], 0, 0):
         return out
-    if n == 1:
-        out[0] = _segment_clearance(occ, ox, oy, res, p[0, 0], p[0, 1], p[0, 0], p[0, 1],
-                                    math.inf, sr, sc)
-        return out
+    ws = _workspace(meta)
     for i in range(m):
-        out[i] = _segment_clearance(occ, ox, oy, res, p[i, 0], p[i, 1], p[i + 1, 0], p[i + 1, 1],
-                                    math.inf, sr, sc)
+        j = min(i + 1, n - 1)  # a one-point path is the segment from that point to itself
+        # (the two searches are called here, not through a helper taking every array: a
+        # call per segment with that many arrays costs as much as the ring search itself)
+        d, final = _ring_search(occ, ox, oy, res, p[i, 0], p[i, 1], p[j, 0], p[j, 1], math.inf)
+        if not final:
+            d = _pyramid_search(occ, pyr, meta, ox, oy, res, p[i, 0], p[i, 1], p[j, 0], p[j, 1],
+                                d, ws)
+        out[i] = d
     return out
 
 
 @njit(cache=True)
-def geometry_kernel(occ, ox, oy, res, x0, y0, x1, y1, p):
+def geometry_kernel(occ, pyr, meta, ox, oy, res, x0, y0, x1, y1, p):
     """(min clearance, every point in [x0, x1] x [y0, y1]) of the (N, 2) path ``p`` (N >= 1).
 
     One pass; each segment's search is pruned by the least clearance found so
@@ -324,15 +386,15 @@ def geometry_kernel(occ, ox, oy, res, x0, y0, x1, y1, p):
             inside = False
             break
     best = math.inf
-    sr, sc = _first_obstacle(occ)
-    if sr < 0:
+    if not _block_full(occ, pyr, meta, meta.shape[0], 0, 0):
         return best, inside
-    if n == 1:
-        return _segment_clearance(occ, ox, oy, res, p[0, 0], p[0, 1], p[0, 0], p[0, 1],
-                                  best, sr, sc), inside
-    for i in range(n - 1):
-        best = _segment_clearance(occ, ox, oy, res, p[i, 0], p[i, 1], p[i + 1, 0], p[i + 1, 1],
-                                  best, sr, sc)
+    ws = _workspace(meta)
+    for i in range(max(n - 1, 1)):
+        j = min(i + 1, n - 1)
+        best, final = _ring_search(occ, ox, oy, res, p[i, 0], p[i, 1], p[j, 0], p[j, 1], best)
+        if not final:
+            best = _pyramid_search(occ, pyr, meta, ox, oy, res, p[i, 0], p[i, 1], p[j, 0],
+                                   p[j, 1], best, ws)
         if best == 0.0:
             break
     return best, inside
@@ -368,9 +430,9 @@ def shape_kernel(p):
 
 
 @njit(cache=True)
-def evaluate_kernel(occ, ox, oy, res, x0, y0, x1, y1, p):
+def evaluate_kernel(occ, pyr, meta, ox, oy, res, x0, y0, x1, y1, p):
     """:func:`geometry_kernel` and :func:`shape_kernel` in one call (``p`` non-empty)."""
-    clearance, inside = geometry_kernel(occ, ox, oy, res, x0, y0, x1, y1, p)
+    clearance, inside = geometry_kernel(occ, pyr, meta, ox, oy, res, x0, y0, x1, y1, p)
     lengths, turns = shape_kernel(p)
     return clearance, inside, lengths, turns
 
@@ -385,7 +447,8 @@ def warmup() -> None:
         occ = np.zeros((2, 3), dtype=bool)
         occ[1, 1] = True
         occ.setflags(write=writable)
-        segment_clearances_kernel(occ, 0.0, 0.0, 1.0, p)
-        geometry_kernel(occ, 0.0, 0.0, 1.0, 0.0, 0.0, 3.0, 2.0, p)
-        evaluate_kernel(occ, 0.0, 0.0, 1.0, 0.0, 0.0, 3.0, 2.0, p)
+        pyr, meta = build_pyramid(occ)
+        segment_clearances_kernel(occ, pyr, meta, 0.0, 0.0, 1.0, p)
+        geometry_kernel(occ, pyr, meta, 0.0, 0.0, 1.0, 0.0, 0.0, 3.0, 2.0, p)
+        evaluate_kernel(occ, pyr, meta, 0.0, 0.0, 1.0, 0.0, 0.0, 3.0, 2.0, p)
     shape_kernel(p)

@@ -5,16 +5,20 @@ Cases
 1. Paper maps (15 m x 15 m, 1 m cells, 50 obstacles; seeds 0..N-1): the
    paths of the planners astar, apf, fusion, ref6 and ref7 from
    ``PAPER_START`` to ``PAPER_GOAL`` (failed plans keep their partial path).
-2. One large case: a MovingAI map (default ``Boston_0_1024.map``), the
+2. Large cases: a MovingAI map (default ``Boston_0_1024.map``), the
    scenario problem whose optimal length is closest to ``--big-length``,
    planned with ``--big-planner`` (ref6 makes 0.1 m steps: a few thousand
-   points).  Skipped if the map file is missing.
+   points; skipped if the map file is missing); and a synthetic open room,
+   1024 x 1024 with walls on the border only and a 3000-point circle around
+   the centre, 411 m from the nearest wall (the worst case for a search that
+   grows windows around each segment).  Fewer, longer timing samples.
 
 Tools, all timed on the same cases, interleaved repeat by repeat (their
 order rotating) so that machine noise hits them alike
 ---------------------------------------------------------------------
-* ``new``: :func:`pathfuse.metrics.evaluate` (numba kernels; compiled by a
-  warm-up call before any timing).
+* ``new``: :func:`pathfuse.metrics.evaluate` (numba kernels, compiled before
+  any timing; the per-map occupancy pyramid is built by a warm-up call and
+  cached, its build time printed for the large maps).
 * ``old``: the previous implementation, a k-d tree over the occupied cell
   centres with candidate lists handled in Python, copied below verbatim as
   the BASELINE (its per-map tree is built by the warm-up call and cached, as
@@ -62,7 +66,7 @@ from pathfuse import metrics
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.grid import GridMap
 from pathfuse.metrics_kernels import warmup as warmup_metrics
-from pathfuse.result import PlanResult
+from pathfuse.result import PlanResult, Status
 
 try:
     import shapely
@@ -334,6 +338,39 @@ def _print_summary(s: dict) -> None:
     print(f"  {'':<8} {'':<6} {ratios}")
 
 
+def _large_case(desc: str, label: str, grid: GridMap, res: PlanResult, args, counts) -> dict:
+    """Time one large case; the per-map structures are built (and timed) once beforehand."""
+    t0 = time.perf_counter()
+    metrics._pyramid(grid)  # the new code's per-map pyramid, cached like the old tree
+    t_pyr = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    _old_tree(grid)
+    t_tree = time.perf_counter() - t0
+    _check(grid, res, label, counts)
+    union, t_union = None, float("nan")
+    if shapely:
+        t0 = time.perf_counter()
+        union = _union(grid, runs=True)
+        t_union = time.perf_counter() - t0
+    fns = _fns(grid, res, union)
+    if "shapely" in fns:
+        d_sh, d_new = fns["shapely"](), metrics.min_clearance(grid, res.path)
+        assert math.isclose(d_sh, d_new, rel_tol=1e-9, abs_tol=1e-9), (label, d_sh, d_new)
+    row = _time_case(fns, max(3, args.repeat // 2), 4 * args.sample_ms / 1e3)
+    out = _summary([row], label)
+    out.update(desc=desc, map=grid.name, shape=list(grid.shape), points=len(res.path),
+               min_clearance_m=metrics.min_clearance(grid, res.path),
+               build_ms={"pyramid": t_pyr * 1e3, "old_tree": t_tree * 1e3,
+                         "shapely_union": t_union * 1e3})
+    print(f"\n{label}: {grid.name} {grid.shape[0]}x{grid.shape[1]}, "
+          f"{int(grid.occupied.sum())} occupied cells; {desc}; {len(res.path)} points, "
+          f"clearance {out['min_clearance_m']:.6f} m")
+    print(f"  built once per map, untimed: new pyramid {t_pyr * 1e3:.1f} ms, old k-d tree "
+          f"{t_tree * 1e3:.1f} ms" + (f", shapely union {t_union:.2f} s" if shapely else ""))
+    _print_summary(out)
+    return out
+
+
 def _load() -> str:
     la = os.getloadavg()
     return f"{la[0]:.2f} {la[1]:.2f} {la[2]:.2f}"
@@ -400,45 +437,35 @@ def main(argv: list[str] | None = None) -> dict:
               f"{statistics.median(t_unions) * 1e3:.3f} ms (median), once per map")
     print(f"  paper maps took {time.perf_counter() - t_start:.1f} s; load average now {_load()}")
 
-    big = None
+    large = []
     if not args.no_big:
         path = Path(args.big_map)
         if not path.exists():
             print(f"\nlarge case skipped: {path} not found")
         else:
             grid = pathfuse.load_map(str(path))
-            scen = Path(str(path) + ".scen")
-            probs = pathfuse.read_scen(scen, grid)
+            probs = pathfuse.read_scen(Path(str(path) + ".scen"), grid)
             prob = min(probs, key=lambda p: abs(p.optimal_length - args.big_length))
             res = pathfuse.plan(grid, prob.start, prob.goal, planner=args.big_planner)
-            _check(grid, res, "large case", counts)
-            union = None
-            if shapely:
-                t0 = time.perf_counter()
-                union = _union(grid, runs=True)
-                t_union = time.perf_counter() - t0
-            fns = _fns(grid, res, union)
-            if "shapely" in fns:
-                d_sh, d_new = fns["shapely"](), metrics.min_clearance(grid, res.path)
-                assert math.isclose(d_sh, d_new, rel_tol=1e-9, abs_tol=1e-9), (d_sh, d_new)
-            row = _time_case(fns, args.repeat, sample_s)
-            row.update(planner=args.big_planner, points=len(res.path))
-            big = _summary([row], "large")
-            big.update(map=path.name, shape=list(grid.shape), points=len(res.path),
-                       planner=args.big_planner, status=res.status.name,
-                       scen_line=prob.line, min_clearance_m=metrics.min_clearance(grid, res.path))
-            print(f"\nlarge case: {path.name} {grid.shape[0]}x{grid.shape[1]}, "
-                  f"{int(grid.occupied.sum())} occupied cells; scen line {prob.line} "
-                  f"(optimal {prob.optimal_length:.1f} m), {args.big_planner}: "
-                  f"{res.status.name}, {len(res.path)} points, "
-                  f"clearance {big['min_clearance_m']:.6f} m"
-                  + (f"; shapely union built in {t_union:.1f} s (untimed)" if shapely else ""))
-            _print_summary(big)
+            large.append(_large_case(
+                f"{path.name}, scen line {prob.line} (optimal {prob.optimal_length:.1f} m), "
+                f"{args.big_planner}: {res.status.name}", "large", grid, res, args, counts))
+        # an open room: the clearance is hundreds of cells, the worst case of a search
+        # that grows windows around each segment
+        occ = np.zeros((1024, 1024), dtype=bool)
+        occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+        grid = GridMap(occ, name="open1024")
+        t = np.linspace(0.0, 2 * np.pi, 3000)
+        circle = np.c_[512 + 100 * np.cos(t), 512 + 100 * np.sin(t)]
+        res = PlanResult(Status.SUCCESS, circle, planner="circle")
+        large.append(_large_case("synthetic open room (walls on the border only), "
+                                 "circle of radius 100 m round the centre", "open",
+                                 grid, res, args, counts))
 
     print(f"\nchecks: new == old evaluate() and segment_clearances() on all {counts['cases']} "
           f"cases ({counts['identical']} bit for bit); shapely clearance agrees to 1e-9")
     print(f"load average at end: {_load()}")
-    out = {"cores": ncpu, "usable_cores": avail, "paper": summaries, "large": big,
+    out = {"cores": ncpu, "usable_cores": avail, "paper": summaries, "large": large,
            "shapely_union_ms": statistics.median(t_unions) * 1e3 if t_unions else None,
            "checks": counts, "loadavg_end": os.getloadavg()}
     if args.json:

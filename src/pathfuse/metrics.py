@@ -5,11 +5,12 @@ path is the polyline through its points.
 
 * :func:`min_clearance` -- exact distance from the polyline to the nearest
   occupied square (0 when it touches or enters one; ``inf`` on a map without
-  obstacles).  Computed per segment with an exact segment-to-square distance
+  obstacles).  Computed per segment by a numba kernel
+  (:mod:`pathfuse.metrics_kernels`) with an exact segment-to-square distance
   (a slab intersection test, then the vertex-to-edge distances of the two
-  convex shapes); candidate squares come from a k-d tree over the occupied
-  cell centres, searched with a radius that provably contains the nearest
-  square.
+  convex shapes), visiting only the cells in rings around the segment up to
+  the ring that provably cannot hold a closer square, and beyond a few rings
+  the blocks of an occupancy pyramid (built once per map) that can.
 * :func:`collision_free` -- every point inside the map rectangle and, for a
   point robot (``robot_radius_m == 0``), no contact with any occupied square:
   touching counts, so a diagonal that squeezes through the shared corner of
@@ -19,7 +20,10 @@ path is the polyline through its points.
 * :func:`path_length` (m), :func:`smoothness` (sum of absolute heading
   changes between successive non-zero segments, radians), :func:`n_steps`
   (segments), :func:`r_ratio` (paper eq. 10-11), and :func:`evaluate`, all of
-  them for a :class:`~pathfuse.result.PlanResult`.
+  them for a :class:`~pathfuse.result.PlanResult`.  :func:`evaluate` walks
+  the path once (one kernel call) for the clearance, the bounds, the lengths
+  and the turns, and reuses that clearance for ``min_clearance_m`` and
+  ``collision_free``.
 
 Examples
 --------
@@ -44,9 +48,15 @@ import weakref
 from typing import Any
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from pathfuse.grid import GridMap
+from pathfuse.metrics_kernels import (
+    build_pyramid,
+    evaluate_kernel,
+    geometry_kernel,
+    segment_clearances_kernel,
+    shape_kernel,
+)
 from pathfuse.result import ConfigError, PlanResult, QueryError
 
 __all__ = [
@@ -61,9 +71,18 @@ __all__ = [
     "evaluate",
 ]
 
-_TREES: weakref.WeakKeyDictionary[GridMap, tuple[cKDTree, np.ndarray] | None] = (
+
+# occupancy pyramid of each map (pathfuse.metrics_kernels.build_pyramid), built on first use
+_PYRAMIDS: weakref.WeakKeyDictionary[GridMap, tuple[np.ndarray, np.ndarray]] = (
     weakref.WeakKeyDictionary()
 )
+
+
+def _pyramid(grid: GridMap) -> tuple[np.ndarray, np.ndarray]:
+    entry = _PYRAMIDS.get(grid)
+    if entry is None:
+        entry = _PYRAMIDS[grid] = build_pyramid(grid.occupied)
+    return entry
 
 
 def _path(path: object) -> np.ndarray:
@@ -87,8 +106,7 @@ def path_length(path: object) -> float:
     p = _path(path)
     if p.shape[0] < 2:
         return 0.0
-    d = np.diff(p, axis=0)
-    return float(np.sqrt((d * d).sum(axis=1)).sum())
+    return float(shape_kernel(np.ascontiguousarray(p))[0].sum())
 
 
 def n_steps(path: object) -> int:
@@ -114,96 +132,28 @@ def smoothness(path: object) -> float:
     p = _path(path)
     if p.shape[0] < 3:
         return 0.0
-    d = np.diff(p, axis=0)
-    d = d[(d != 0).any(axis=1)]
-    if d.shape[0] < 2:
-        return 0.0
-    h = np.arctan2(d[:, 1], d[:, 0])
-    dh = np.diff(h)
-    dh = (dh + np.pi) % (2 * np.pi) - np.pi
-    return float(np.abs(dh).sum())
+    return float(shape_kernel(np.ascontiguousarray(p))[1].sum())
 
 
-def _tree(grid: GridMap) -> tuple[cKDTree, np.ndarray] | None:
-    if grid in _TREES:
-        return _TREES[grid]
-    cells = np.argwhere(grid.occupied)
-    if cells.shape[0] == 0:
-        entry = None
-    else:
-        centres = grid.cell_to_world(cells)
-        entry = (cKDTree(centres), centres)
-    _TREES[grid] = entry
-    return entry
+def _geometry(grid: GridMap, p: np.ndarray) -> tuple[float, bool]:
+    """(min clearance, in bounds) of a validated non-empty path, in one pass."""
+    x0, y0, x1, y1 = grid.bounds
+    c, inside = geometry_kernel(grid.occupied, *_pyramid(grid), grid.origin[0], grid.origin[1],
+                                grid.resolution, x0, y0, x1, y1, np.ascontiguousarray(p))
+    return float(c), bool(inside)
 
 
-def _point_box_dist(px, py, x0, y0, x1, y1):
-    dx = np.maximum(np.maximum(x0 - px, px - x1), 0.0)
-    dy = np.maximum(np.maximum(y0 - py, py - y1), 0.0)
-    return np.hypot(dx, dy)
+def _radius(robot_radius_m: float) -> float:
+    r = float(robot_radius_m)
+    if not math.isfinite(r) or r < 0:
+        raise ConfigError(f"robot_radius_m: must be a finite number >= 0, got {robot_radius_m!r}")
+    return r
 
 
-def _point_seg_dist(px, py, ax, ay, bx, by):
-    vx, vy = bx - ax, by - ay
-    l2 = vx * vx + vy * vy
-    with np.errstate(invalid="ignore", divide="ignore"):
-        t = np.where(l2 > 0, ((px - ax) * vx + (py - ay) * vy) / np.where(l2 > 0, l2, 1.0), 0.0)
-    t = np.clip(t, 0.0, 1.0)
-    return np.hypot(px - (ax + t * vx), py - (ay + t * vy))
-
-
-def _seg_hits_box(ax, ay, bx, by, x0, y0, x1, y1):
-    """Closed segment vs closed box intersection (Liang-Barsky slabs), vectorised."""
-    t0 = np.zeros(np.broadcast(ax, x0).shape)
-    t1 = np.ones_like(t0)
-    ok = np.ones(t0.shape, dtype=bool)
-    for a, b, lo, hi in ((ax, bx, x0, x1), (ay, by, y0, y1)):
-        d = b - a
-        flat = d == 0
-        ok &= ~(flat & ((a < lo) | (a > hi)))
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            dd = np.where(flat, 1.0, d)
-            ta = (lo - a) / dd
-            tb = (hi - a) / dd
-        tmin = np.where(flat, -np.inf, np.minimum(ta, tb))
-        tmax = np.where(flat, np.inf, np.maximum(ta, tb))
-        t0 = np.maximum(t0, tmin)
-        t1 = np.minimum(t1, tmax)
-    return ok & (t0 <= t1)
-
-
-def _seg_box_dist(ax, ay, bx, by, x0, y0, x1, y1):
-    d = np.minimum(_point_box_dist(ax, ay, x0, y0, x1, y1), _point_box_dist(bx, by, x0, y0, x1, y1))
-    for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
-        d = np.minimum(d, _point_seg_dist(cx, cy, ax, ay, bx, by))
-    return np.where(_seg_hits_box(ax, ay, bx, by, x0, y0, x1, y1), 0.0, d)
-
-
-def _group_min(values: np.ndarray, groups: np.ndarray, n: int) -> np.ndarray:
-    out = np.full(n, np.inf)
-    np.minimum.at(out, groups, values)
-    return out
-
-
-def _candidates(tree: cKDTree, centres_q: np.ndarray, radii: np.ndarray):
-    lists = tree.query_ball_point(centres_q, r=radii)
-    lens = np.fromiter((len(x) for x in lists), dtype=np.int64, count=len(lists))
-    if lens.sum() == 0:
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    idx = np.concatenate([np.asarray(x, dtype=np.int64) for x in lists if len(x)])
-    owner = np.repeat(np.arange(len(lists)), lens)
-    return owner, idx
-
-
-def _point_clearances(grid: GridMap, p: np.ndarray, tree, centres) -> np.ndarray:
-    h = grid.resolution / 2
-    near, _ = tree.query(p)
-    # the nearest square's centre lies within (distance to nearest centre) + half a diagonal
-    owner, idx = _candidates(tree, p, near + h * math.sqrt(2) + 1e-9 * grid.resolution)
-    c = centres[idx]
-    d = _point_box_dist(p[owner, 0], p[owner, 1], c[:, 0] - h, c[:, 1] - h, c[:, 0] + h,
-                        c[:, 1] + h)
-    return _group_min(d, owner, p.shape[0])
+def _is_free(clearance: float, inside: bool, r: float) -> bool:
+    if not inside:
+        return False
+    return clearance > 0.0 if r == 0.0 else clearance >= r
 
 
 def segment_clearances(grid: GridMap, path: object) -> np.ndarray:
@@ -220,25 +170,8 @@ def segment_clearances(grid: GridMap, path: object) -> np.ndarray:
     p = _path(path)
     if p.shape[0] == 0:
         return np.zeros(0)
-    entry = _tree(grid)
-    n = max(p.shape[0] - 1, 1)
-    if entry is None:
-        return np.full(n, np.inf)
-    tree, centres = entry
-    dp = _point_clearances(grid, p, tree, centres)
-    if p.shape[0] == 1:
-        return dp
-    a, b = p[:-1], p[1:]
-    upper = np.minimum(dp[:-1], dp[1:])
-    mid = 0.5 * (a + b)
-    half = 0.5 * np.hypot(*(b - a).T)
-    h = grid.resolution / 2
-    radii = upper + half + h * math.sqrt(2) + 1e-9 * grid.resolution
-    owner, idx = _candidates(tree, mid, radii)
-    c = centres[idx]
-    d = _seg_box_dist(a[owner, 0], a[owner, 1], b[owner, 0], b[owner, 1], c[:, 0] - h,
-                      c[:, 1] - h, c[:, 0] + h, c[:, 1] + h)
-    return np.minimum(_group_min(d, owner, n), upper)
+    return segment_clearances_kernel(grid.occupied, *_pyramid(grid), grid.origin[0],
+                                     grid.origin[1], grid.resolution, np.ascontiguousarray(p))
 
 
 def min_clearance(grid: GridMap, path: object) -> float:
@@ -248,8 +181,8 @@ def min_clearance(grid: GridMap, path: object) -> float:
     >>> round(min_clearance(g, [[0.2, 0.2]]), 6)          # to the corner (1, 1)
     1.131371
     """
-    d = segment_clearances(grid, path)
-    return float(d.min()) if d.size else math.inf
+    p = _path(path)
+    return _geometry(grid, p)[0] if p.shape[0] else math.inf
 
 
 def in_bounds(grid: GridMap, path: object) -> bool:
@@ -274,16 +207,11 @@ def collision_free(grid: GridMap, path: object, robot_radius_m: float = 0.0) -> 
     >>> collision_free(g, [[0.5, 1.5], [1.5, 0.5]])   # corner-cutting diagonal
     False
     """
-    r = float(robot_radius_m)
-    if not math.isfinite(r) or r < 0:
-        raise ConfigError(f"robot_radius_m must be a finite number >= 0, got {robot_radius_m!r}")
+    r = _radius(robot_radius_m)
     p = _path(path)
     if p.shape[0] == 0:
         return True
-    if not in_bounds(grid, p):
-        return False
-    c = min_clearance(grid, p)
-    return c > 0.0 if r == 0.0 else c >= r
+    return _is_free(*_geometry(grid, p), r)
 
 
 def r_ratio(a: float, b: float) -> float:
@@ -322,6 +250,18 @@ def evaluate(grid: GridMap, result: PlanResult, robot_radius_m: float = 0.0) -> 
     (2.0, True, 0.5, 1)
     """
     p = _path(result.path)
+    r = _radius(robot_radius_m)
+    if p.shape[0]:
+        # one pass of the path for clearance (-> min_clearance_m, collision_free), bounds,
+        # segment lengths and turns
+        x0, y0, x1, y1 = grid.bounds
+        clearance, inside, lengths, turns = evaluate_kernel(
+            grid.occupied, *_pyramid(grid), grid.origin[0], grid.origin[1], grid.resolution,
+            x0, y0, x1, y1, np.ascontiguousarray(p))
+        clearance, inside = float(clearance), bool(inside)
+        length, turn = float(lengths.sum()), float(turns.sum())
+    else:
+        clearance, inside, length, turn = math.inf, True, 0.0, 0.0
     return {
         "planner": result.planner,
         "status": result.status.name,
@@ -329,10 +269,10 @@ def evaluate(grid: GridMap, result: PlanResult, robot_radius_m: float = 0.0) -> 
         "time_s": float(result.time_s),
         "iterations": int(result.iterations),
         "expansions": int(result.expansions),
-        "length_m": path_length(p),
-        "steps": n_steps(p),
-        "smoothness_rad": smoothness(p),
-        "min_clearance_m": min_clearance(grid, p),
-        "in_bounds": in_bounds(grid, p) if p.shape[0] else True,
-        "collision_free": collision_free(grid, p, robot_radius_m),
+        "length_m": length,
+        "steps": max(p.shape[0] - 1, 0),
+        "smoothness_rad": turn,
+        "min_clearance_m": clearance,
+        "in_bounds": inside,
+        "collision_free": _is_free(clearance, inside, r),
     }

@@ -8,14 +8,14 @@ import pytest
 from PIL import Image
 from scipy import stats as sps
 
-from pathfuse.dynamic import (
+from pathfuse.result import ConfigError
+from pathfuse.studies.dynamic import (
     OUTCOMES,
     DynamicConfig,
     run_dynamic,
     summary_rows,
     write_dynamic_outputs,
 )
-from pathfuse.result import ConfigError
 from pathfuse.world import simulate
 from pathfuse.world.generate import generate_scenarios
 

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from pathfuse.paper import (
+from pathfuse.result import ConfigError
+from pathfuse.studies.paper import (
     PAPER_PLANNERS,
     PaperConfig,
     mean_ci,
@@ -16,7 +17,6 @@ from pathfuse.paper import (
     wilson_ci,
     write_paper_outputs,
 )
-from pathfuse.result import ConfigError
 
 
 def test_mean_ci_matches_scipy_t_interval():

@@ -315,9 +315,17 @@ def cmd_planners(args: argparse.Namespace) -> int:
     return 0
 
 
+def _study_db(out: str) -> Path:
+    """The result store of a preset study: ``OUT/study.db`` (the folder is created)."""
+    folder = Path(out).expanduser()
+    if folder.exists() and not folder.is_dir():
+        raise CliError(f"--out: {folder} exists and is not a folder")
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder / "study.db"
+
+
 def cmd_paper(args: argparse.Namespace) -> int:
-    from pathfuse.bench.progress import ProgressBar
-    from pathfuse.paper import PaperConfig, run_paper, summary_rows, write_paper_outputs
+    from pathfuse.studies.paper import PaperConfig, run_paper, summary_rows, write_paper_outputs
 
     cfg = PaperConfig(
         n_seeds=args.seeds, first_seed=args.first_seed,
@@ -329,20 +337,16 @@ def cmd_paper(args: argparse.Namespace) -> int:
             f"--seed {cfg.figure_seed} is not among the maps run "
             f"({cfg.first_seed}..{cfg.first_seed + cfg.n_seeds - 1})"
         )
-    bar = ProgressBar(cfg.n_seeds, label="paper maps", enabled=not args.quiet)
-    done = [0]
-
-    def progress(i: int, n: int) -> None:
-        bar.update(i - done[0])
-        done[0] = i
-
-    run = run_paper(cfg, progress=progress)
-    bar.close()
+    for name in cfg.planners:
+        _warm_with_notice(name)
+    run = run_paper(cfg, progress=False if args.quiet else None, workers=args.workers,
+                    db_path=_study_db(args.out))
     files = write_paper_outputs(run, args.out)
     n_runs = len(run.records)
-    print(f"{n_runs} runs on {cfg.n_seeds} maps in {run.wall_s:.2f} s "
-          f"({n_runs / max(run.wall_s, 1e-9):.0f} runs/s, "
-          f"{cfg.n_seeds / max(run.wall_s, 1e-9):.1f} maps/s)")
+    sm = run.summary
+    print(f"{n_runs} runs on {cfg.n_seeds} maps: {sm.ran} run now in {run.wall_s:.2f} s "
+          f"({sm.runs_per_s:.0f} runs/s, {sm.workers} worker{'s' if sm.workers != 1 else ''})"
+          + (f", {sm.skipped} already in {sm.db_path}" if sm.skipped else ""))
     print(f"{'planner':<8} {'success':>12} {'length mean':>12} {'R_length':>10} {'time mean':>11}")
     for r in summary_rows(run):
         rl = "-" if r["planner"] == "fusion" else f"{100 * r['r_length_mean']:+.2f}%"
@@ -414,8 +418,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def cmd_dynamic(args: argparse.Namespace) -> int:
-    from pathfuse.bench.progress import ProgressBar
-    from pathfuse.dynamic import (
+    from pathfuse.studies.dynamic import (
         DynamicConfig,
         run_dynamic,
         success_pivot,
@@ -428,15 +431,10 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
         planners=parse_planner_list(args.planners), seed=args.seed,
         params=parse_planner_params(args.param),
     )
-    bar = ProgressBar(cfg.n_episodes, label="dynamic", enabled=not args.quiet)
-    done = [0]
-
-    def progress(i: int, n: int) -> None:
-        bar.update(i - done[0])
-        done[0] = i
-
-    run = run_dynamic(cfg, progress=progress, workers=args.workers)
-    bar.close()
+    for name in cfg.planners:
+        _warm_with_notice(name)
+    run = run_dynamic(cfg, progress=False if args.quiet else None, workers=args.workers,
+                      db_path=_study_db(args.out))
     files = write_dynamic_outputs(run, args.out)
     print(f"{len(run.records)} episodes ({len(cfg.planners)} planners x {len(cfg.moving)} disc "
           f"counts x {cfg.n_seeds} scenarios) in {run.wall_s:.2f} s "
@@ -617,8 +615,13 @@ examples:
                     help="the map of the one-map tables and Fig. 3 (default: the first seed)")
     pp.add_argument("--step", type=_float, default=0.1,
                     help="step length in metres of every stepping planner (default 0.1)")
-    pp.add_argument("--out", default="paper-out", help="output folder (default paper-out)")
-    pp.add_argument("--quiet", action="store_true", help="no progress bar")
+    pp.add_argument("--workers", type=_positive_int, default=None,
+                    help="worker processes (default: every usable CPU; 1 = in this process)")
+    pp.add_argument("--out", default="paper-out",
+                    help="output folder (default paper-out); its study.db keeps every run, "
+                    "so running the same command again resumes or reuses them")
+    pp.add_argument("--quiet", action="store_true",
+                    help="no progress bar (default: a bar on stderr when it is a terminal)")
     pp.set_defaults(func=cmd_paper)
 
     sm = sub.add_parser(
@@ -694,10 +697,13 @@ examples:
                     help="planner parameter, repeatable (e.g. --param fusion.swerve=0)")
     dy.add_argument("--seed", type=_nonneg_int, default=0,
                     help="master seed of the scenario family (default 0)")
-    dy.add_argument("--workers", type=_positive_int, default=1,
-                    help="worker processes (default 1; a pool costs ~1-2 s to start)")
-    dy.add_argument("--out", default="dynamic-out", help="output folder (default dynamic-out)")
-    dy.add_argument("--quiet", action="store_true", help="no progress bar")
+    dy.add_argument("--workers", type=_positive_int, default=None,
+                    help="worker processes (default: every usable CPU; 1 = in this process)")
+    dy.add_argument("--out", default="dynamic-out",
+                    help="output folder (default dynamic-out); its study.db keeps every "
+                    "episode, so running the same command again resumes or reuses them")
+    dy.add_argument("--quiet", action="store_true",
+                    help="no progress bar (default: a bar on stderr when it is a terminal)")
     dy.set_defaults(func=cmd_dynamic)
 
     b = sub.add_parser(

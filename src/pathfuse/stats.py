@@ -5,8 +5,7 @@
 * :func:`markdown_table` - a list of rows as a GitHub Markdown table;
 * :func:`write_csv` - dict rows (or plain rows) to a CSV file.
 
-Used by :mod:`pathfuse.paper` (static reproduction) and :mod:`pathfuse.dynamic`
-(the moving-obstacle benchmark).
+Used by the study engine (:mod:`pathfuse.bench.summary`) and its presets.
 """
 
 from __future__ import annotations

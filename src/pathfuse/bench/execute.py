@@ -377,6 +377,7 @@ def run_static(group: Mapping[str, Any], run: Mapping[str, Any],
         "solved": bool(res.success),
         "time": float(res.time_s),
         "solution_length": float(res.length) if res.success else None,
+        "path_length": float(res.length),
         "expansions": int(res.expansions),
         "iterations": int(res.iterations),
         "message": res.message,
@@ -423,7 +424,12 @@ def run_dynamic(group: Mapping[str, Any], run: Mapping[str, Any],
 
     params = dict(run["params"])
     choice = {"name": run["planner"], "params": params} if params else run["planner"]
-    ep = simulate(_scenario(group), planner=choice, seed=int(run["seed"]))
+    spec = group.get("map_spec") or {}
+    dyn = spec.get("dynamic") if isinstance(spec, Mapping) else None
+    # a scenario picked from a family by its index keeps its own episode seed;
+    # otherwise the run's seed is the episode seed
+    seed = None if isinstance(dyn, Mapping) and "family_seed" in dyn else int(run["seed"])
+    ep = simulate(_scenario(group), planner=choice, seed=seed)
     return episode_row(ep, store_paths)
 
 
@@ -451,6 +457,7 @@ def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
         "time": compute,
         "solution_length": _num(getattr(ep, "path_length_m", None)) if solved else None,
         "time_to_goal": _num(getattr(ep, "time_to_goal_s", None)) if solved else None,
+        "path_length": _num(getattr(ep, "path_length_m", None)),
         "collisions": 0 if coll is None else 1,
         "collision_free": coll is None,
         "iterations": int(getattr(ep, "n_ticks", 0)),
@@ -464,8 +471,9 @@ def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
         row["goal_x"], row["goal_y"] = (float(c) for c in sc.goal)
     sc_d = {k: v for k, v in d.items() if k not in ("params", "scenario", "planner")}
     timing = {k: v for k, v in _scalars(sc_d).items() if _is_timing(k) and "to_goal" not in k}
-    row["metrics"] = json.dumps({k: v for k, v in _scalars(sc_d).items() if k not in timing},
-                                sort_keys=True)
+    names = {} if sc is None else {"scenario": str(sc.name), "map": str(sc.grid.name)}
+    row["metrics"] = json.dumps({**{k: v for k, v in _scalars(sc_d).items() if k not in timing},
+                                 **names}, sort_keys=True)
     row["timing"] = json.dumps(timing, sort_keys=True)
     if store_paths and positions.shape[0]:
         row["path"] = _path_blob(positions)

@@ -110,6 +110,7 @@ __all__ = [
     "RunSpec",
     "load_experiment",
     "parse_experiment",
+    "experiment_from_dict",
     "parse_seeds",
     "canonical_json",
     "run_key",
@@ -522,6 +523,12 @@ class Experiment:
                 p = self.resolve(dyn)
                 portable: dict[str, Any] = {"dynamic": dyn, "sha256": file_digest(p)}
                 load: dict[str, Any] = {"dynamic": str(p.resolve())}
+            elif "generate" in dyn and dyn.get("family_seed") is not None:
+                # scenario number `seed` of one family: the episode keeps the scenario's seed
+                portable = {"dynamic": {"generate": dyn["generate"],
+                                        "family_seed": int(dyn["family_seed"]),
+                                        "index": int(seed)}}
+                load = portable
             elif "generate" in dyn:  # a generated family: one scenario per seed
                 portable = {"dynamic": {"generate": dyn["generate"], "seed": int(seed)}}
                 load = portable
@@ -663,9 +670,11 @@ def load_map(spec: Mapping[str, Any], base_dir: str | os.PathLike[str] = ".") ->
 def load_dynamic(spec: Mapping[str, Any]) -> Any:
     """The :class:`~pathfuse.world.Scenario` of a loadable dynamic spec.
 
-    ``{"dynamic": FILE}``, ``{"dynamic": {inline scenario}, "base_dir": DIR}`` or
+    ``{"dynamic": FILE}``, ``{"dynamic": {inline scenario}, "base_dir": DIR}``,
     ``{"dynamic": {"generate": {...}, "seed": S}}`` (scenario 0 of the family
-    :func:`pathfuse.world.generate.generate_scenarios` draws with seed ``S``).
+    :func:`pathfuse.world.generate.generate_scenarios` draws with seed ``S``) or
+    ``{"dynamic": {"generate": {...}, "family_seed": F, "index": I}}`` (scenario
+    ``I`` of the family with seed ``F``).
     """
     from pathfuse.world import load_scenario
 
@@ -673,6 +682,9 @@ def load_dynamic(spec: Mapping[str, Any]) -> Any:
     if isinstance(dyn, Mapping) and "generate" in dyn:
         from pathfuse.world.generate import generate_scenarios
 
+        if "family_seed" in dyn:
+            return generate_scenarios(1, seed=int(dyn["family_seed"]), first=int(dyn["index"]),
+                                      **dict(dyn["generate"]))[0]
         return generate_scenarios(1, seed=int(dyn["seed"]), **dict(dyn["generate"]))[0]
     if isinstance(dyn, Mapping) and spec.get("base_dir"):
         d = json.loads(canonical_json(dyn))
@@ -742,6 +754,19 @@ def parse_experiment(text: str, path: str | os.PathLike[str] = "experiment.yaml"
         if not msg.startswith(str(path)):
             msg = f"{path}: {msg}"
         raise ConfigError(msg) from None
+
+
+def experiment_from_dict(doc: Mapping[str, Any], path: str | os.PathLike[str],
+                         check_maps: bool = True) -> Experiment:
+    """Validate an experiment given as a dict (the presets ``pathfuse paper`` and
+    ``pathfuse dynamic`` build theirs this way); ``path`` names it and anchors relative
+    paths, and its YAML is kept as the experiment's text."""
+    path = Path(path)
+    text = yaml.safe_dump(_plain(dict(doc)), sort_keys=False)
+    try:
+        return _parse(dict(doc), path, text, None, check_maps)
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: {exc}") from None
 
 
 def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
@@ -1126,15 +1151,20 @@ def _check_generate(dyn: Mapping[str, Any], where: str) -> None:
 
     from pathfuse.world.generate import generate_scenarios
 
-    if set(dyn) != {"generate"} or not isinstance(dyn["generate"], Mapping):
+    if not set(dyn) <= {"generate", "family_seed"} or "generate" not in dyn \
+            or not isinstance(dyn["generate"], Mapping):
         raise ConfigError(f"{where}: expected {{generate: {{moving: K, speed_range: [lo, hi], "
-                          f"...}}}} alone, got {_short(dict(dyn))}")
+                          f"...}}}} (and optionally family_seed: S), got {_short(dict(dyn))}")
+    fs = dyn.get("family_seed")
+    if fs is not None and (not _is_int(fs) or fs < 0):
+        raise ConfigError(f"{where}.family_seed: must be an integer >= 0, got {_short(fs)}")
     allowed = [p for p in inspect.signature(generate_scenarios).parameters
-               if p not in ("n_scenarios", "seed")]
+               if p not in ("n_scenarios", "seed", "first")]
     for k in dyn["generate"]:
         if k not in allowed:
             raise ConfigError(f"{where}.generate.{k}: unknown argument; expected one of "
-                              f"{', '.join(allowed)} (the run's seed is the family seed)")
+                              f"{', '.join(allowed)} (the run's seed is the family seed, "
+                              "or with family_seed the scenario's index)")
 
 
 def _entry_name(v: Mapping[str, Any], where: str, default: str) -> str:

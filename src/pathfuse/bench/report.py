@@ -89,8 +89,9 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse.bench.summary import group_stats
 from pathfuse.result import ConfigError
-from pathfuse.stats import markdown_table, mean_ci, wilson_ci, write_csv
+from pathfuse.stats import markdown_table, write_csv
 
 __all__ = [
     "ConfigInfo",
@@ -397,52 +398,8 @@ def _reference_label(study: Study, reference: str | None) -> str:
 
 
 # --------------------------------------------------------------------------- statistics
-def _median(v: Sequence[float]) -> float:
-    return float(np.median(v)) if len(v) else math.nan
-
-
 def _group_stats(runs: Sequence[Mapping[str, Any]], rl: Mapping[int, float]) -> dict[str, Any]:
-    n = len(runs)
-    solved = [r for r in runs if r["solved"]]
-    errors = sum(r["status_name"] == "ERROR" for r in runs)
-    statuses: dict[str, int] = {}
-    for r in runs:
-        if not r["solved"]:
-            s = r["status_name"] or "UNKNOWN"
-            statuses[s] = statuses.get(s, 0) + 1
-    sr = wilson_ci(len(solved), n)
-    checked = [r for r in solved if r["collision_free"] is not None]
-    cf = sum(bool(r["collision_free"]) for r in checked)
-    cfr = wilson_ci(cf, len(checked))
-    coll = sum(1 for r in runs if (r["collisions"] or 0) > 0)
-    cr = wilson_ci(coll, n)
-    lengths = [float(r["solution_length"]) for r in solved if r["solution_length"] is not None]
-    times = [float(r["time"]) for r in runs
-             if r["status_name"] != "ERROR" and r["time"] is not None]
-    ttg = [float(r["time_to_goal"]) for r in solved if r["time_to_goal"] is not None]
-    rv = [rl[r["id"]] for r in runs if r["id"] in rl]
-    lm, tm, gm, rm = mean_ci(lengths), mean_ci(times), mean_ci(ttg), mean_ci(rv)
-    return {
-        "runs": n, "solved": len(solved), "not_solved": n - len(solved) - errors,
-        "errors": errors,
-        "failures": "; ".join(f"{k}:{v}" for k, v in sorted(statuses.items())),
-        "success_rate": sr[0], "success_ci_low": sr[1], "success_ci_high": sr[2],
-        "collision_checked": len(checked), "collision_free": cf,
-        "collision_free_rate": cfr[0], "collision_free_ci_low": cfr[1],
-        "collision_free_ci_high": cfr[2],
-        "collision_runs": coll, "collision_rate": cr[0], "collision_ci_low": cr[1],
-        "collision_ci_high": cr[2],
-        "length_n": len(lengths), "length_mean_m": lm[0], "length_ci_low_m": lm[1],
-        "length_ci_high_m": lm[2], "length_median_m": _median(lengths),
-        "time_n": len(times), "time_mean_s": tm[0], "time_ci_low_s": tm[1],
-        "time_ci_high_s": tm[2], "time_median_s": _median(times),
-        "time_to_goal_n": len(ttg), "time_to_goal_mean_s": gm[0],
-        "time_to_goal_ci_low_s": gm[1], "time_to_goal_ci_high_s": gm[2],
-        "time_to_goal_median_s": _median(ttg),
-        "r_length_pairs": len(rv), "r_length_mean": rm[0], "r_length_ci_low": rm[1],
-        "r_length_ci_high": rm[2], "r_length_median": _median(rv),
-        "r_length_shorter": sum(v < 0 for v in rv),
-    }
+    return group_stats(runs, rl)
 
 
 def _scopes(study: Study) -> list[tuple[str, str, list[dict[str, Any]], bool]]:

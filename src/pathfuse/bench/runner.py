@@ -44,7 +44,6 @@ from pathfuse.bench.experiment import (
     Experiment,
     RunSpec,
     canonical_json,
-    file_digest,
     iter_groups,
     load_dynamic,
     load_experiment,
@@ -54,8 +53,8 @@ from pathfuse.bench.progress import ProgressBar
 from pathfuse.bench.store import ResultStore
 from pathfuse.result import ConfigError, PathfuseError
 
-__all__ = ["run_bench", "SweepSummary", "SweepInterrupted", "WorkersCannotStart", "make_batches",
-           "default_workers"]
+__all__ = ["run_bench", "run_experiment", "SweepSummary", "SweepInterrupted",
+           "WorkersCannotStart", "make_batches", "default_workers"]
 
 CRASH_TEXT = ("WorkerCrashed: the worker process died while running this run "
               "(segfault, os._exit, out of memory or killed)")
@@ -557,19 +556,53 @@ def run_bench(
         Ctrl-C; everything finished before it is stored.
     """
     t0 = time.perf_counter()
+    _check_counts(workers, batch_size)
+    exp = load_experiment(experiment_path, seeds=seeds)
+    return run_experiment(exp, db_path, workers, scheduler, progress,
+                          retry_errors=retry_errors, batch_size=batch_size, stream=stream,
+                          on_start=on_start, started=t0)
+
+
+def _check_counts(workers: Any, batch_size: Any) -> None:
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
                                 or workers < 1):
         raise ConfigError(f"workers: must be an integer >= 1, got {workers!r}")
     if batch_size is not None and (isinstance(batch_size, bool)
                                    or not isinstance(batch_size, int) or batch_size < 1):
         raise ConfigError(f"batch_size: must be an integer >= 1, got {batch_size!r}")
-    exp = load_experiment(experiment_path, seeds=seeds)
+
+
+def run_experiment(
+    exp: Experiment,
+    db_path: str | os.PathLike[str] | ResultStore,
+    workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool | None = True,
+    *,
+    retry_errors: bool = False,
+    batch_size: int | None = None,
+    stream: Any = None,
+    on_start: Callable[[int, int], None] | None = None,
+    started: float | None = None,
+    label: str | None = None,
+) -> SweepSummary:
+    """Run (or resume) a validated :class:`Experiment` into a result database.
+
+    The engine behind :func:`run_bench` and the presets ``pathfuse paper`` and
+    ``pathfuse dynamic``; the arguments are those of :func:`run_bench`
+    (``db_path`` may also be an open :class:`ResultStore`, left open; ``label``
+    names the progress bar, default the experiment's name).
+    """
+    t0 = time.perf_counter() if started is None else started
+    _check_counts(workers, batch_size)
+    experiment_path = exp.path
     runs = exp.expand()
     nworkers = default_workers() if workers is None else workers
     if scheduler is not None:
         _connect_check(scheduler)
-    store = ResultStore(db_path)
-    summary = SweepSummary(experiment=exp.name, db_path=str(db_path), total=len(runs),
+    own_store = not isinstance(db_path, ResultStore)
+    store = ResultStore(db_path) if own_store else db_path
+    summary = SweepSummary(experiment=exp.name, db_path=str(store.path), total=len(runs),
                            workers=nworkers,
                            scheduler=_scheduler_name(scheduler))
     try:
@@ -578,14 +611,16 @@ def run_bench(
         summary.skipped = len(runs) - len(todo)
         if on_start is not None:
             on_start(len(runs), len(todo))
+        import hashlib
+
         session = store.start_session(
             study=exp.name, experiment_file=str(Path(experiment_path)),
-            experiment_sha256=file_digest(Path(experiment_path)),
+            experiment_sha256=hashlib.sha256(exp.text.encode("utf-8")).hexdigest()[:16],
             experiment_text=exp.text, workers=nworkers, scheduler=summary.scheduler,
             planned=len(runs), skipped=summary.skipped)
         enabled = bool(progress) if progress is not None else bool(
             getattr(stream or sys.stderr, "isatty", lambda: False)())
-        bar = ProgressBar(len(runs), label=exp.name, stream=stream, enabled=enabled and
+        bar = ProgressBar(len(runs), label=label or exp.name, stream=stream, enabled=enabled and
                           bool(todo), initial=summary.skipped)
         sink = _Sink(store, exp, runs, summary, bar)
         state = "failed"
@@ -615,7 +650,8 @@ def run_bench(
             except Exception:  # noqa: BLE001 - never mask the original error
                 pass
     finally:
-        store.close()
+        if own_store:
+            store.close()
     return summary
 
 

@@ -44,7 +44,9 @@ runs (pathfuse columns)
     ``map_name``; ``planner``; ``seed``; ``query_index``; ``scen_line``;
     ``start_x``, ``start_y``, ``goal_x``, ``goal_y`` (m); ``status_name``;
     ``expansions``; ``iterations``; ``steps``; ``collision_free`` (BOOLEAN);
-    ``collisions`` (INTEGER); ``time_to_goal`` (REAL, s, dynamic runs);
+    ``collisions`` (INTEGER); ``time_to_goal`` (REAL, s, dynamic runs); ``path_length``
+    (REAL, m: the returned path's length, also when not solved; the driven trajectory's
+    for a dynamic run);
     ``reference_length`` (m: the scen file's optimum, or the reference
     planner's length on the same query); ``reference_source``; ``R_length``
     (``(solution_length - reference_length) / reference_length``, the
@@ -157,6 +159,8 @@ RUN_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("collision_free", "BOOLEAN", "path collision-free for the robot radius"),
     ("collisions", "INTEGER", "number of collisions (0 when collision-free)"),
     ("time_to_goal", "REAL", "dynamic runs: simulated time to reach the goal in s"),
+    ("path_length", "REAL", "length in m of the returned path, also when not solved (a local "
+     "planner's partial path; the driven trajectory of a dynamic run)"),
     ("reference_length", "REAL", "scen optimum or reference planner length in m"),
     ("reference_source", "TEXT", "'scen' or the reference planner's name"),
     ("R_length", "REAL", "(solution_length - reference_length) / reference_length"),
@@ -458,6 +462,17 @@ class ResultStore:
                               [*fields.values(), session_id])
 
     # ---------------------------------------------------------------- reading
+    def rows_by_key(self, keys: Sequence[str]) -> dict[str, dict[str, Any]]:
+        """The stored ``runs`` rows of the given run keys (missing keys are left out)."""
+        out: dict[str, dict[str, Any]] = {}
+        keys = list(keys)
+        for i in range(0, len(keys), 500):
+            chunk = keys[i:i + 500]
+            marks = ", ".join("?" for _ in chunk)
+            for r in self.conn.execute(f"SELECT * FROM runs WHERE run_key IN ({marks})", chunk):
+                out[r["run_key"]] = dict(r)
+        return out
+
     def results(self, where: str = "", params: Sequence[Any] = ()) -> list[dict[str, Any]]:
         """Rows of the ``pathfuse_results`` view (optionally filtered by SQL ``where``)."""
         sql = "SELECT * FROM pathfuse_results" + (f" WHERE {where}" if where else "") + \

@@ -218,7 +218,12 @@ class FieldController(Controller):
             msg = self.success_message(total)
         else:
             msg = self.failure_message(code, status, path, total)
-        return Outcome(status, path, total, elapsed, msg, info)
+        return Outcome(status, path, total, elapsed, msg, info, self.length_of(path))
+
+    def length_of(self, path: np.ndarray) -> float | None:
+        """The path's length when the controller sums it its own way (None: summed by
+        :func:`pathfuse.result.path_length`)."""
+        return None
 
     def extra_info(self) -> dict[str, Any]:
         """Controller-specific entries of ``PlanResult.info``."""

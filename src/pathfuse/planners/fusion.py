@@ -160,6 +160,9 @@ class FusionController(FieldController):
         # the escape found no way back to the path: wait a stall window before the next try
         self.state[S_REF] = self.n - 1
 
+    def length_of(self, path: np.ndarray) -> float | None:
+        return float(polyline_cumlen(path)[-1])
+
     @property
     def escapes(self) -> int:
         return int(self.state[S_ESCAPES])

@@ -544,7 +544,7 @@ def plot_success_vs_moving(
 ) -> Figure:
     """Success rate (with its 95 % Wilson interval) against the number of moving discs.
 
-    ``rows`` are summary rows of :func:`pathfuse.dynamic.summary_rows` (keys
+    ``rows`` are summary rows of :func:`pathfuse.studies.dynamic.summary_rows` (keys
     ``planner``, ``moving``, ``reached_rate``, ``reached_ci_low``,
     ``reached_ci_high``); one line per planner, the points of different
     planners nudged sideways so their error bars do not overlap.  Saved to

@@ -2,30 +2,31 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
 from pathfuse.viz.figures import PLANNER_COLOURS, draw_map, plt
-
-if TYPE_CHECKING:
-    from pathfuse.paper import PaperRun
 
 __all__ = ["plot_fig3", "plot_r_length"]
 
 _FIG3_ORDER = (("apf", "(a)"), ("astar", "(b)"), ("ref6", "(c)"), ("ref7", "(d)"))
 
 
-def plot_fig3(run: PaperRun, out: str | Path, dpi: int = 120) -> None:
-    """The paper's Fig. 3: the fusion path against each reference on one map."""
-    from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
-    from pathfuse.paper import PAPER_LABELS
+def plot_fig3(results: Mapping[str, Any], seed: int, labels: Mapping[str, str],
+              out: str | Path, dpi: int = 120) -> None:
+    """The paper's Fig. 3: the fusion path against each reference on the map of ``seed``.
 
-    seed = run.config.figure_seed
+    ``results`` maps planner names to their :class:`~pathfuse.PlanResult` on that map.
+    """
+    from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
+
+    PAPER_LABELS = labels  # noqa: N806
     grid = paper_map(seed)
-    fusion = run.results.get((seed, "fusion"))
-    refs = [(k, tag) for k, tag in _FIG3_ORDER if (seed, k) in run.results]
+    fusion = results.get("fusion")
+    refs = [(k, tag) for k, tag in _FIG3_ORDER if k in results]
     ncol = 2
     nrow = max(1, (len(refs) + 1) // 2)
     fig, axes = plt.subplots(nrow, ncol, figsize=(10, 5.8 * nrow), squeeze=False)
@@ -36,7 +37,7 @@ def plot_fig3(run: PaperRun, out: str | Path, dpi: int = 120) -> None:
         if fusion is not None and "astar_path" in fusion.info:
             a = np.asarray(fusion.info["astar_path"])
             ax.plot(a[:, 0], a[:, 1], "o", ms=3, color="#1f77b4", alpha=0.6, label="A* points")
-        for res in (run.results[(seed, name)], fusion):
+        for res in (results[name], fusion):
             if res is None or len(res.path) == 0:
                 continue
             p = np.asarray(res.path)
@@ -54,10 +55,10 @@ def plot_fig3(run: PaperRun, out: str | Path, dpi: int = 120) -> None:
     plt.close(fig)
 
 
-def plot_r_length(run: PaperRun, r_by_ref: dict[str, np.ndarray], out: str | Path,
-                  dpi: int = 120) -> None:
+def plot_r_length(r_by_ref: Mapping[str, np.ndarray], n_maps: int, labels: Mapping[str, str],
+                  out: str | Path, dpi: int = 120) -> None:
     """Box plot of R_length = (L_fusion - L_ref) / L_ref per reference, in percent."""
-    from pathfuse.paper import PAPER_LABELS
+    PAPER_LABELS = labels  # noqa: N806
 
     names = [k for k in r_by_ref if r_by_ref[k].size]
     fig, ax = plt.subplots(figsize=(8, 4.5))
@@ -69,7 +70,7 @@ def plot_r_length(run: PaperRun, r_by_ref: dict[str, np.ndarray], out: str | Pat
     ax.axhline(0.0, color="k", lw=0.8, ls="--")
     ax.set_ylabel("R_length = (L_fusion - L_ref) / L_ref  [%]")
     ax.set_title(f"Fusion path length relative to each reference over "
-                 f"{run.config.n_seeds} maps (below 0: fusion shorter)", fontsize=10)
+                 f"{n_maps} maps (below 0: fusion shorter)", fontsize=10)
     fig.tight_layout()
     fig.savefig(out, dpi=dpi)
     plt.close(fig)

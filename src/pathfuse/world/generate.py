@@ -173,6 +173,7 @@ def generate_scenarios(
     min_start_gap_m: float = 1.0,
     min_goal_gap_m: float = 0.5,
     name: str = "generated",
+    first: int = 0,
 ) -> list[Scenario]:
     """A deterministic family of dynamic scenarios.
 
@@ -210,6 +211,9 @@ def generate_scenarios(
         Least initial gap between a disc and the robot at the start / at the goal.
     name : str
         Scenario names are ``f"{name}-{seed}-{i}"``.
+    first : int
+        Index of the first scenario: ``generate_scenarios(1, first=i)`` is
+        scenario ``i`` of the family, without drawing the ones before it.
 
     Returns
     -------
@@ -246,7 +250,7 @@ def generate_scenarios(
         fixed_spec = dict(map)
 
     out = []
-    for i in range(int(n_scenarios)):
+    for i in range(int(first), int(first) + int(n_scenarios)):
         rng = np.random.default_rng([int(seed), i])
         if fixed_grid is None:
             map_seed = int(rng.integers(0, 2**31 - 1))

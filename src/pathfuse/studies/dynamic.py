@@ -1,4 +1,4 @@
-"""The dynamic benchmark: online planners among moving obstacles.
+"""The dynamic benchmark: planners online among moving obstacles (a preset study).
 
 The paper's claim is that A* alone cannot handle dynamic obstacles while the
 A*-APF fusion can.  :func:`run_dynamic` measures it: for every number of
@@ -6,9 +6,11 @@ moving discs ``K`` in ``config.moving`` it draws the same ``n_seeds``
 scenarios with :func:`pathfuse.world.generate.generate_scenarios` (paper map
 family, start (1, 1), goal (11, 11), discs aimed across the robot's route,
 deterministic in ``config.seed``; scenario ``i`` sits on the same map for
-every ``K``) and runs every online planner through each of them with
-:func:`pathfuse.world.simulate`.  Nothing is dropped: every episode is a row
-of the per-episode CSV, whatever its status.
+every ``K``) and runs every planner through each of them with
+:func:`pathfuse.world.simulate`, as an experiment of the study engine
+(:func:`dynamic_experiment`; the engine's worker pool, result store and
+progress bar).  Nothing is dropped: every episode is a row of the
+per-episode CSV, whatever its status.
 
 :func:`summary_rows` reduces them per (``K``, planner): the counts of each
 status (they add up to the number of episodes), the success / collision /
@@ -29,17 +31,19 @@ Examples
 
 from __future__ import annotations
 
+import json
 import math
-import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
+import os
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from pathfuse.result import ConfigError, PathfuseError
-from pathfuse.stats import markdown_table, mean_ci, wilson_ci, write_csv
+from pathfuse.bench.summary import group_stats, value_stats
+from pathfuse.result import ConfigError
+from pathfuse.stats import markdown_table, write_csv
 
 __all__ = [
     "DynamicConfig",
@@ -178,157 +182,144 @@ class DynamicRun:
         return len(self.records) / max(self.wall_s, 1e-9)
 
 
-def _record(moving: int, index: int, sc: Any, ep: Any, wall_s: float) -> dict[str, Any]:
+def dynamic_experiment(config: DynamicConfig | None = None,
+                       base_dir: str | os.PathLike[str] = ".") -> Any:
+    """The experiment of the study engine that the benchmark runs.
+
+    One map entry per number of discs ``K`` (named ``kK``): the family
+    :func:`~pathfuse.world.generate.generate_scenarios` draws with the master
+    seed ``config.seed``, scenario ``i`` for the run seed ``i`` (the same maps
+    for every ``K``); every planner of ``config`` with its parameters.
+    """
+    from pathfuse.bench.experiment import experiment_from_dict
+
+    cfg = config or DynamicConfig()
+    lo, hi = cfg.speed_range
+    doc = {
+        "name": "dynamic",
+        "description": "planners among moving discs on the paper map family",
+        "seeds": cfg.n_seeds,
+        "maps": [{"name": f"k{k}",
+                  "dynamic": {"generate": {"moving": k, "speed_range": [lo, hi],
+                                           "name": f"dyn-k{k}"},
+                              "family_seed": cfg.seed}} for k in cfg.moving],
+        "planners": [{"name": n, "params": dict(cfg.params.get(n, {})), "kinds": ["dynamic"]}
+                     if cfg.params.get(n) else {"name": n, "kinds": ["dynamic"]}
+                     for n in cfg.planners],
+    }
+    return experiment_from_dict(doc, Path(base_dir) / "dynamic.yaml", check_maps=False)
+
+
+def _record(moving: int, index: int, row: dict[str, Any]) -> dict[str, Any]:
+    """One episode's record, from its stored run."""
+    m = json.loads(row["metrics"] or "{}")
+    t = json.loads(row["timing"] or "{}")
+
+    def num(key: str) -> float:
+        v = m.get(key)
+        return math.inf if v is None else float(v)  # non-finite values are stored as null
+
     return {
         "moving": int(moving),
         "index": int(index),
-        "scenario": sc.name,
-        "map": sc.grid.name,
-        "planner": ep.planner,
-        "status": ep.status.name,
-        "reached": bool(ep.reached),
-        "path_length_m": float(ep.path_length_m),
-        "time_to_goal_s": None if ep.time_to_goal_s is None else float(ep.time_to_goal_s),
-        "sim_time_s": float(ep.times[-1]),
-        "n_ticks": int(ep.n_ticks),
-        "min_distance_m": float(ep.min_distance_m),
-        "min_obstacle_distance_m": float(ep.min_obstacle_distance_m),
-        "min_static_clearance_m": float(ep.min_static_clearance_m),
-        "collision_with": "" if ep.collision_with is None else str(ep.collision_with),
-        "mean_plan_time_s": float(ep.mean_plan_time_s),
-        "max_plan_time_s": float(ep.plan_times_s.max()) if ep.plan_times_s.size else 0.0,
-        "setup_time_s": float(ep.setup_time_s),
-        "wall_s": float(wall_s),
-        "message": ep.message,
+        "scenario": m.get("scenario", ""),
+        "map": m.get("map", ""),
+        "planner": row["planner"],
+        "status": row["status_name"],
+        "reached": bool(row["solved"]),
+        "path_length_m": float(m.get("path_length_m", 0.0)),
+        "time_to_goal_s": None if m.get("time_to_goal_s") is None
+        else float(m["time_to_goal_s"]),
+        "sim_time_s": float(m.get("n_ticks", 0)) * float(m.get("dt", 0.0)),
+        "n_ticks": int(m.get("n_ticks", 0)),
+        "min_distance_m": num("min_distance_m"),
+        "min_obstacle_distance_m": num("min_obstacle_distance_m"),
+        "min_static_clearance_m": num("min_static_clearance_m"),
+        "collision_with": "" if m.get("collision_with") is None else str(m["collision_with"]),
+        "mean_plan_time_s": float(t.get("mean_plan_time_s", 0.0)),
+        "max_plan_time_s": float(t.get("max_plan_time_s", 0.0)),
+        "setup_time_s": float(t.get("setup_time_s", 0.0)),
+        "wall_s": float(row["wall_time"] or 0.0),
+        "message": row["message"] or "",
     }
-
-
-def _run_task(task: tuple[int, int, Any, tuple[str, ...], dict[str, Any]]
-              ) -> list[dict[str, Any]]:
-    """One scenario through every planner (what a worker process runs)."""
-    from pathfuse.world import simulate
-
-    moving, index, sc, planners, choices = task
-    out = []
-    for name in planners:
-        t0 = time.perf_counter()
-        ep = simulate(sc, planner=choices[name])
-        out.append(_record(moving, index, sc, ep, time.perf_counter() - t0))
-    return out
-
-
-def _worker_init() -> None:
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's business
-
-
-def _run_pool(tasks: list[Any], workers: int
-              ) -> Iterator[tuple[tuple[int, int], list[dict[str, Any]]]]:
-    """Yield ``((moving, index), records)`` as worker processes finish scenarios."""
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-    from concurrent.futures.process import BrokenProcessPool
-
-    if "forkserver" in mp.get_all_start_methods():
-        ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["pathfuse.dynamic", "pathfuse.world"])
-    else:  # pragma: no cover - Windows
-        ctx = mp.get_context("spawn")
-    from pathfuse.bench.runner import _main_without_file
-
-    with _main_without_file():
-        ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init)
-        try:
-            futs = {ex.submit(_run_task, t): (t[0], t[1]) for t in tasks}
-            for f in as_completed(futs):
-                yield futs[f], f.result()
-        except BrokenProcessPool as exc:
-            raise PathfuseError(f"a worker process died ({exc}); run with workers=1 to see "
-                                "the problem in this process") from None
-        finally:
-            ex.shutdown(wait=True, cancel_futures=True)
 
 
 def run_dynamic(
     config: DynamicConfig | None = None,
-    progress: Callable[[int, int], None] | None = None,
-    workers: int = 1,
+    progress: bool | None = False,
+    workers: int | None = 1,
+    db_path: str | os.PathLike[str] | None = None,
+    stream: Any = None,
 ) -> DynamicRun:
-    """Run the benchmark.
+    """Run the benchmark with the study engine.
 
     Parameters
     ----------
     config : DynamicConfig, optional
         Default ``DynamicConfig()``.
-    progress : callable, optional
-        ``progress(done, total)`` after every scenario (``done`` episodes).
-    workers : int
-        Processes; 1 runs in this process.  The records (timings aside) do
-        not depend on it, and come back in the same order: by ``moving`` as
-        configured, then scenario index, then planner.
+    progress : bool or None
+        Show the engine's progress bar (None: when stderr is a terminal).
+    workers : int or None
+        Processes of the engine's pool (1: in this process; None: every CPU).
+        The records (timings aside) do not depend on it, and come back in the
+        same order: by ``moving`` as configured, then scenario index, then
+        planner.
+    db_path : path, optional
+        Keep the episodes in this result store (default: in memory); episodes
+        already stored there are not run again.
 
     Returns
     -------
     DynamicRun
     """
-    from pathfuse.world.generate import generate_scenarios
+    from pathfuse.bench.runner import run_experiment
+    from pathfuse.bench.store import ResultStore
 
     cfg = config or DynamicConfig()
-    if not _is_int(workers) or workers < 1:
-        raise ConfigError(f"workers: expected a positive integer, got {workers!r}")
-    choices = {n: cfg.choice(n) for n in cfg.planners}
-    t0 = time.perf_counter()
-    tasks = []
-    for k in cfg.moving:
-        scs = generate_scenarios(cfg.n_seeds, moving=k, speed_range=cfg.speed_range,
-                                 seed=cfg.seed, name=f"dyn-k{k}")
-        tasks += [(k, i, sc, cfg.planners, choices) for i, sc in enumerate(scs)]
-    total = cfg.n_episodes
-    results: dict[tuple[int, int], list[dict[str, Any]]] = {}
-    done = 0
-    if workers == 1 or len(tasks) <= 1:
-        for task in tasks:
-            results[(task[0], task[1])] = _run_task(task)
-            done += len(cfg.planners)
-            if progress is not None:
-                progress(done, total)
-    else:
-        for key, recs in _run_pool(tasks, min(workers, len(tasks))):
-            results[key] = recs
-            done += len(cfg.planners)
-            if progress is not None:
-                progress(done, total)
-    records = [r for t in tasks for r in results[(t[0], t[1])]]
-    return DynamicRun(cfg, records, time.perf_counter() - t0, workers=int(workers))
+    if workers is not None and (not _is_int(workers) or workers < 1):
+        raise ConfigError(f"workers: must be a positive integer, got {workers!r}")
+    exp = dynamic_experiment(cfg)
+    specs = exp.expand()
+    store = ResultStore(":memory:" if db_path is None else db_path)
+    try:
+        summary = run_experiment(exp, store, workers=workers, progress=progress, stream=stream,
+                                 label="dynamic")
+        stored = store.rows_by_key([r.key for r in specs])
+    finally:
+        store.close()
+    moving = {f"k{k}": k for k in cfg.moving}
+    order = {n: i for i, n in enumerate(cfg.planners)}
+    rank = {k: i for i, k in enumerate(cfg.moving)}
+    ordered = sorted(specs, key=lambda r: (rank[moving[r.group]], r.seed, order[r.planner]))
+    records = [_record(moving[r.group], r.seed, stored[r.key]) for r in ordered]
+    return DynamicRun(cfg, records, summary.wall_s, workers=summary.workers)
 
 
 # --------------------------------------------------------------------------- statistics
 def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
     """One row per (moving, planner): status counts and rates with 95 % Wilson intervals,
     path length and time to goal over the successful episodes (mean, 95 % CI, median),
-    and the mean planning time per tick."""
+    and the mean planning time per tick (:func:`~pathfuse.bench.summary.group_stats`)."""
     rows = []
     for k in run.config.moving:
         for name in run.config.planners:
             recs = [r for r in run.records if r["moving"] == k and r["planner"] == name]
-            n = len(recs)
-            row: dict[str, Any] = {"moving": k, "planner": name, "episodes": n}
+            g = group_stats([{"solved": r["reached"], "status_name": r["status"],
+                              "solution_length": None, "time": None, "time_to_goal": None}
+                             for r in recs], statuses=OUTCOMES)
+            row: dict[str, Any] = {"moving": k, "planner": name, "episodes": g["runs"]}
             for st in OUTCOMES:
-                row[_OUTCOME_KEYS[st]] = sum(r["status"] == st for r in recs)
+                row[_OUTCOME_KEYS[st]] = g[st.lower()]
             for st in OUTCOMES:
-                key = _OUTCOME_KEYS[st]
-                p, lo, hi = wilson_ci(row[key], n)
-                row.update({f"{key}_rate": p, f"{key}_ci_low": lo, f"{key}_ci_high": hi})
+                key, low = _OUTCOME_KEYS[st], st.lower()
+                row.update({f"{key}_rate": g[f"{low}_rate"], f"{key}_ci_low": g[f"{low}_ci_low"],
+                            f"{key}_ci_high": g[f"{low}_ci_high"]})
             ok = [r for r in recs if r["status"] == "SUCCESS"]
-            for col, label, unit in (("path_length_m", "path_length", "m"),
-                                     ("time_to_goal_s", "time_to_goal", "s")):
-                vals = [float(r[col]) for r in ok]
-                m, lo, hi = mean_ci(vals)
-                row.update({f"{label}_mean_{unit}": m, f"{label}_ci_low_{unit}": lo,
-                            f"{label}_ci_high_{unit}": hi,
-                            f"{label}_median_{unit}": float(np.median(vals)) if vals
-                            else math.nan})
+            for col, label, unit in (("path_length_m", "path_length", "_m"),
+                                     ("time_to_goal_s", "time_to_goal", "_s")):
+                v = value_stats([float(r[col]) for r in ok], label, unit)
+                v.pop(f"{label}_n")
+                row.update(v)
             row["mean_plan_time_us"] = 1e6 * float(np.mean([r["mean_plan_time_s"]
                                                            for r in recs])) if recs else math.nan
             rows.append(row)

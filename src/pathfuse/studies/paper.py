@@ -1,11 +1,13 @@
-"""Reproduction of the paper's experiment (Section IV, Tables I and II, Fig. 3).
+"""Reproduction of the paper's experiment (Section IV, Tables I and II, Fig. 3): a preset study.
 
 The paper ran its five planners once, on one random 15 m map.  :func:`run_paper`
-runs them on ``n_seeds`` seeded paper-setup maps (15 m x 15 m, 1 m cells,
-start (1, 1), goal (11, 11), 50 random obstacle cells, K_att 40, K_rep 5,
-rho_0 2 m) and keeps every run, failures included; :func:`write_paper_outputs`
-writes the tables (one map, and statistics over all maps), the Fig. 3
-comparison and a box plot of R_length.
+builds an experiment of the study engine (:mod:`pathfuse.bench`) that runs
+them on ``n_seeds`` seeded paper-setup maps (15 m x 15 m, 1 m cells, start
+(1, 1), goal (11, 11), 50 random obstacle cells, K_att 40, K_rep 5, rho_0 2 m),
+runs it into a result store (resumable: the same command finishes an
+interrupted run) and reads every run back, failures included;
+:func:`write_paper_outputs` writes the tables (one map, and statistics over
+all maps), the Fig. 3 comparison and a box plot of R_length.
 
 Failures are never dropped: a planner that fails on a map counts against its
 success rate, and R_length / R_time statistics are over the maps where *both*
@@ -15,17 +17,16 @@ fusion and the reference succeeded, with that count printed beside them.
 from __future__ import annotations
 
 import math
-import time
-from collections.abc import Callable
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from pathfuse.api import plan
+from pathfuse.bench.summary import group_stats, median, value_stats
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
-from pathfuse.metrics import evaluate, r_ratio
+from pathfuse.metrics import r_ratio
 from pathfuse.result import ConfigError
 from pathfuse.stats import markdown_table as _md
 from pathfuse.stats import mean_ci, wilson_ci
@@ -36,7 +37,9 @@ __all__ = [
     "PAPER_LABELS",
     "PaperConfig",
     "PaperRun",
+    "paper_experiment",
     "run_paper",
+    "summary_rows",
     "write_paper_outputs",
     "mean_ci",
     "wilson_ci",
@@ -97,9 +100,9 @@ class PaperConfig:
 
     def __post_init__(self) -> None:
         if not isinstance(self.n_seeds, int) or self.n_seeds < 1:
-            raise ConfigError(f"n_seeds must be a positive integer, got {self.n_seeds!r}")
+            raise ConfigError(f"n_seeds: must be a positive integer, got {self.n_seeds!r}")
         if "fusion" not in self.planners:
-            raise ConfigError("planners must include 'fusion' (R_length is relative to it)")
+            raise ConfigError("planners: must include 'fusion' (R_length is relative to it)")
 
     def planner_params(self, name: str) -> dict[str, Any]:
         base: dict[str, Any] = {}
@@ -112,12 +115,14 @@ class PaperConfig:
 
 @dataclass
 class PaperRun:
-    """All records of a reproduction: one dict per (seed, planner)."""
+    """All records of a reproduction: one dict per (seed, planner), seed-major."""
 
     config: PaperConfig
     records: list[dict[str, Any]]
     wall_s: float
     results: dict[tuple[int, str], Any] = field(default_factory=dict, repr=False)
+    summary: Any = None
+    """The :class:`~pathfuse.bench.runner.SweepSummary` of the engine run."""
 
     def by_planner(self, name: str) -> list[dict[str, Any]]:
         return [r for r in self.records if r["planner"] == name]
@@ -126,46 +131,96 @@ class PaperRun:
         return sorted({r["seed"] for r in self.records})
 
 
+def paper_experiment(config: PaperConfig | None = None, base_dir: str | os.PathLike[str] = "."
+                     ) -> Any:
+    """The experiment of the study engine that the reproduction runs.
+
+    One map entry (the paper's map family, a fresh map per seed, the paper's
+    start and goal), every planner of ``config`` with the paper's constants
+    and one common step, no R_length reference (the reproduction pairs each
+    planner with the fusion itself), no limits beyond each planner's own
+    finite defaults.
+    """
+    from pathfuse.bench.experiment import experiment_from_dict
+
+    cfg = config or PaperConfig()
+    doc = {
+        "name": "paper",
+        "description": "Ju, Luo and Yan, Sec. IV: five planners on seeded 15 m paper maps",
+        "seeds": {"start": cfg.first_seed, "count": cfg.n_seeds},
+        "reference": None,
+        "maps": [{"name": "paper", "map": "paper"}],
+        "planners": [{"name": n, "params": cfg.planner_params(n)} if cfg.planner_params(n)
+                     else n for n in cfg.planners],
+    }
+    return experiment_from_dict(doc, Path(base_dir) / "paper.yaml", check_maps=False)
+
+
 def run_paper(
     config: PaperConfig | None = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: bool | None = False,
+    workers: int | None = 1,
+    db_path: str | os.PathLike[str] | None = None,
+    stream: Any = None,
 ) -> PaperRun:
-    """Run every planner of ``config`` on every seeded paper map.
+    """Run every planner of ``config`` on every seeded paper map with the study engine.
 
     Each record holds: seed, planner, status, success, collision_free,
-    length_m, time_s (planning wall clock, A* included where used, numba
-    compilation excluded), min_clearance_m, smoothness_rad, steps,
-    expansions, iterations.  ``progress(done, total)`` is called per map.
+    length_m (the partial path's on failure), time_s (planning wall clock, A*
+    included where used, numba compilation excluded), min_clearance_m,
+    smoothness_rad, steps, expansions, iterations.  ``db_path`` keeps the
+    runs (default: an in-memory store); runs already stored there are not
+    run again.  ``workers`` > 1 runs a process pool (the engine's).
     """
+    from pathfuse.bench.runner import run_experiment
+    from pathfuse.bench.store import ResultStore
+
     cfg = config or PaperConfig()
-    seeds = range(cfg.first_seed, cfg.first_seed + cfg.n_seeds)
-    records: list[dict[str, Any]] = []
-    keep: dict[tuple[int, str], Any] = {}
-    t0 = time.perf_counter()
-    for i, seed in enumerate(seeds):
-        grid = paper_map(seed)
-        for name in cfg.planners:
-            res = plan(grid, PAPER_START, PAPER_GOAL, planner=name, **cfg.planner_params(name))
-            m = evaluate(grid, res)
-            records.append({
-                "seed": seed,
-                "planner": name,
-                "status": res.status.name,
-                "success": bool(res.success),
-                "collision_free": bool(m["collision_free"]),
-                "length_m": float(res.length),
-                "time_s": float(res.time_s),
-                "min_clearance_m": float(m["min_clearance_m"]),
-                "smoothness_rad": float(m["smoothness_rad"]),
-                "steps": int(m["steps"]),
-                "expansions": int(res.expansions),
-                "iterations": int(res.iterations),
-            })
-            if seed == cfg.figure_seed:
-                keep[(seed, name)] = res
-        if progress is not None:
-            progress(i + 1, cfg.n_seeds)
-    return PaperRun(cfg, records, time.perf_counter() - t0, keep)
+    exp = paper_experiment(cfg)
+    specs = exp.expand()
+    store = ResultStore(":memory:" if db_path is None else db_path)
+    try:
+        summary = run_experiment(exp, store, workers=workers, progress=progress,
+                                 stream=stream, label="paper")
+        stored = store.rows_by_key([r.key for r in specs])
+    finally:
+        store.close()
+    order = {name: i for i, name in enumerate(cfg.planners)}
+    records = [_record(r.seed, r.planner, stored[r.key]) for r in
+               sorted(specs, key=lambda r: (r.seed, order[r.planner]))]
+    return PaperRun(cfg, records, summary.wall_s, _figure_plans(cfg), summary)
+
+
+def _record(seed: int, planner: str, row: dict[str, Any]) -> dict[str, Any]:
+    solved = bool(row["solved"])
+    length = row["solution_length"] if solved else row["path_length"]
+    clear = row["solution_clearance"]
+    return {
+        "seed": seed,
+        "planner": planner,
+        "status": row["status_name"],
+        "success": solved,
+        "collision_free": bool(row["collision_free"]),
+        "length_m": float(length or 0.0),
+        "time_s": float(row["time"] or 0.0),
+        "min_clearance_m": math.inf if clear is None else float(clear),
+        "smoothness_rad": float(row["solution_smoothness"] or 0.0),
+        "steps": int(row["steps"] or 0),
+        "expansions": int(row["expansions"] or 0),
+        "iterations": int(row["iterations"] or 0),
+        "id": int(row["id"]),
+    }
+
+
+def _figure_plans(cfg: PaperConfig) -> dict[tuple[int, str], Any]:
+    """The plans of the figure's map, planned again here for Fig. 3 (deterministic)."""
+    from pathfuse.api import plan
+
+
+    grid = paper_map(cfg.figure_seed)
+    return {(cfg.figure_seed, name): plan(grid, PAPER_START, PAPER_GOAL, planner=name,
+                                          **cfg.planner_params(name))
+            for name in cfg.planners}
 
 
 # --------------------------------------------------------------------------- statistics
@@ -180,47 +235,49 @@ def _paired(run: PaperRun, ref: str, key: str) -> np.ndarray:
     return np.asarray(out, dtype=float)
 
 
+def _as_run(r: dict[str, Any]) -> dict[str, Any]:
+    """A record in the form :func:`~pathfuse.bench.summary.group_stats` reads."""
+    return {"id": r["id"], "solved": r["success"], "status_name": r["status"],
+            "collision_free": r["collision_free"], "collisions": 0,
+            "solution_length": r["length_m"] if r["success"] else None, "time": r["time_s"],
+            "time_to_goal": None}
+
+
 def summary_rows(run: PaperRun) -> list[dict[str, Any]]:
     """Per-planner statistics over all maps (the rows of the statistics tables)."""
+    fus = {r["seed"]: r for r in run.by_planner("fusion")}
     rows = []
     for name in run.config.planners:
         recs = run.by_planner(name)
-        n = len(recs)
-        ok = [r for r in recs if r["success"]]
-        cf = sum(r["success"] and r["collision_free"] for r in recs)
-        lengths = [r["length_m"] for r in ok]
-        times = [r["time_s"] for r in recs]
-        sr = wilson_ci(len(ok), n)
-        lm = mean_ci(lengths)
-        tm = mean_ci(times)
+        rl: dict[int, float] = {}
+        if name != "fusion":
+            for r in recs:
+                f = fus.get(r["seed"])
+                if f and f["success"] and r["success"] and r["length_m"] > 0:
+                    rl[r["id"]] = r_ratio(f["length_m"], r["length_m"])
+        g = group_stats([_as_run(r) for r in recs], rl)
         row: dict[str, Any] = {
             "planner": name,
-            "maps": n,
-            "successes": len(ok),
-            "success_rate": sr[0], "success_ci_low": sr[1], "success_ci_high": sr[2],
-            "collision_free_successes": cf,
-            "failures": ", ".join(
-                f"{s}:{sum(r['status'] == s for r in recs)}"
-                for s in sorted({r["status"] for r in recs if not r["success"]})
-            ),
-            "length_mean_m": lm[0], "length_ci_low_m": lm[1], "length_ci_high_m": lm[2],
-            "length_median_m": float(np.median(lengths)) if lengths else math.nan,
-            "time_mean_s": tm[0], "time_ci_low_s": tm[1], "time_ci_high_s": tm[2],
-            "time_median_s": float(np.median(times)) if times else math.nan,
+            "maps": g["runs"],
+            "successes": g["solved"],
+            "success_rate": g["success_rate"], "success_ci_low": g["success_ci_low"],
+            "success_ci_high": g["success_ci_high"],
+            "collision_free_successes": g["collision_free"],
+            "failures": g["failures"].replace("; ", ", "),
+            "length_mean_m": g["length_mean_m"], "length_ci_low_m": g["length_ci_low_m"],
+            "length_ci_high_m": g["length_ci_high_m"], "length_median_m": g["length_median_m"],
+            "time_mean_s": g["time_mean_s"], "time_ci_low_s": g["time_ci_low_s"],
+            "time_ci_high_s": g["time_ci_high_s"], "time_median_s": g["time_median_s"],
         }
         for key, label in (("length_m", "r_length"), ("time_s", "r_time")):
-            if name == "fusion":
-                row.update({f"{label}_mean": math.nan, f"{label}_ci_low": math.nan,
-                            f"{label}_ci_high": math.nan, f"{label}_median": math.nan,
-                            f"{label}_pairs": 0, f"{label}_fusion_shorter": 0})
-                continue
-            vals = _paired(run, name, key)
-            m = mean_ci(vals)
+            vals = [] if name == "fusion" else list(_paired(run, name, key))
+            v = value_stats(vals, label)
             row.update({
-                f"{label}_mean": m[0], f"{label}_ci_low": m[1], f"{label}_ci_high": m[2],
-                f"{label}_median": float(np.median(vals)) if vals.size else math.nan,
-                f"{label}_pairs": int(vals.size),
-                f"{label}_fusion_shorter": int((vals < 0).sum()),
+                f"{label}_mean": v[f"{label}_mean"], f"{label}_ci_low": v[f"{label}_ci_low"],
+                f"{label}_ci_high": v[f"{label}_ci_high"],
+                f"{label}_median": median(vals),
+                f"{label}_pairs": len(vals),
+                f"{label}_fusion_shorter": int(sum(x < 0 for x in vals)),
             })
         rows.append(row)
     return rows
@@ -341,7 +398,8 @@ def write_paper_outputs(run: PaperRun, out_dir: str | Path) -> dict[str, Path]:
         "fig3_png": out / "fig3_paths.png",
         "r_length_png": out / "r_length_boxplot.png",
     }
-    _write_csv(files["runs_csv"], run.records)
+    _write_csv(files["runs_csv"], [{k: v for k, v in r.items() if k != "id"}
+                                   for r in run.records])
     _write_csv(files["summary_csv"], rows)
     _write_csv(files["one_map_csv"], one_csv)
     paper_md = _md([
@@ -364,7 +422,9 @@ def write_paper_outputs(run: PaperRun, out_dir: str | Path) -> dict[str, Path]:
     files["tables_md"].write_text(text)
     from pathfuse.viz.paper import plot_fig3, plot_r_length
 
-    plot_fig3(run, files["fig3_png"])
-    plot_r_length(run, {k: _paired(run, k, "length_m") for k in run.config.planners
-                        if k != "fusion"}, files["r_length_png"])
+    seed = run.config.figure_seed
+    plot_fig3({name: res for (sd, name), res in run.results.items() if sd == seed}, seed,
+              PAPER_LABELS, files["fig3_png"])
+    plot_r_length({k: _paired(run, k, "length_m") for k in run.config.planners
+                   if k != "fusion"}, run.config.n_seeds, PAPER_LABELS, files["r_length_png"])
     return files

@@ -19,6 +19,7 @@ from scipy.sparse.csgraph import dijkstra
 
 import pathfuse
 import pathfuse.search.astar as astar_mod
+import pathfuse.search.kernel as kernel_mod
 from pathfuse import Budget, ConfigError, GridMap, MapError, QueryError, Status
 from pathfuse.io.movingai import read_movingai
 from pathfuse.io.scenario import read_scen, scen_map_name
@@ -442,10 +443,10 @@ def test_small_heap_orders_exactly():
     snode = np.empty(300, dtype=np.int32)
     size = 0
     for i, k in enumerate(keys):
-        size = astar_mod._spush(skey, snode, size, k, i)
+        size = kernel_mod._spush(skey, snode, size, k, i)
     out = []
     while size:
-        node, size = astar_mod._spop(skey, snode, size)
+        node, size = kernel_mod._spop(skey, snode, size)
         out.append(node)
     assert sorted(out) == list(range(300))
     assert np.all(np.diff(keys[out].astype(np.int64)) >= 0)

@@ -1,45 +1,61 @@
 """pathfuse: 2-D grid path planning with exact fast A*, artificial potential fields and
 the A*-APF fusion planner of Ju, Luo and Yan.
 
+Every name below is imported on first use (PEP 562), so ``import pathfuse``
+loads neither numpy, numba nor scipy: the command line starts fast, and a
+program pays only for what it uses.
+
 >>> import pathfuse
 >>> g = pathfuse.GridMap.from_rows(["...", ".#.", "..."])
 >>> bool(pathfuse.plan(g, (0.5, 0.5), (2.5, 2.5)))
 True
 """
 
-from pathfuse.api import plan
-from pathfuse.grid import GridMap
-from pathfuse.io import (
-    load_map,
-    map_from_spec,
-    read_image,
-    read_movingai,
-    read_npy,
-    read_ros_map,
-    read_rows_yaml,
-    read_scen,
-    write_movingai,
-    write_ros_map,
-)
-from pathfuse.planners.registry import REGISTRY, get_planner, planner_names
-from pathfuse.result import (
-    Budget,
-    ConfigError,
-    MapError,
-    MapFormatError,
-    PathfuseError,
-    PlanningFailed,
-    PlanResult,
-    QueryError,
-    Status,
-)
-from pathfuse.world import Episode, World, load_scenario, simulate
+from __future__ import annotations
 
-__version__ = "0.1.0"
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from pathfuse._version import __version__
+
+_EXPORTS: dict[str, str] = {
+    "GridMap": "pathfuse.grid",
+    "plan": "pathfuse.api",
+    "Problem": "pathfuse.problem",
+    "Status": "pathfuse.result",
+    "PlanResult": "pathfuse.result",
+    "Budget": "pathfuse.result",
+    "PathfuseError": "pathfuse.result",
+    "MapError": "pathfuse.result",
+    "MapFormatError": "pathfuse.result",
+    "QueryError": "pathfuse.result",
+    "ConfigError": "pathfuse.result",
+    "PlanningFailed": "pathfuse.result",
+    "REGISTRY": "pathfuse.planners.registry",
+    "PlannerSpec": "pathfuse.planners.registry",
+    "get_planner": "pathfuse.planners.registry",
+    "planner_names": "pathfuse.planners.registry",
+    "register_function": "pathfuse.planners.registry",
+    "load_map": "pathfuse.io",
+    "map_from_spec": "pathfuse.io",
+    "read_movingai": "pathfuse.io",
+    "write_movingai": "pathfuse.io",
+    "read_scen": "pathfuse.io",
+    "read_ros_map": "pathfuse.io",
+    "write_ros_map": "pathfuse.io",
+    "read_image": "pathfuse.io",
+    "read_npy": "pathfuse.io",
+    "read_rows_yaml": "pathfuse.io",
+    "simulate": "pathfuse.world.episode",
+    "Episode": "pathfuse.world.episode",
+    "World": "pathfuse.world.world",
+    "load_scenario": "pathfuse.world.scenario",
+}
 
 __all__ = [
     "GridMap",
     "plan",
+    "Problem",
     "Status",
     "PlanResult",
     "Budget",
@@ -50,8 +66,10 @@ __all__ = [
     "ConfigError",
     "PlanningFailed",
     "REGISTRY",
+    "PlannerSpec",
     "get_planner",
     "planner_names",
+    "register_function",
     "load_map",
     "map_from_spec",
     "read_movingai",
@@ -63,8 +81,60 @@ __all__ = [
     "read_npy",
     "read_rows_yaml",
     "simulate",
-    "World",
     "Episode",
+    "World",
     "load_scenario",
     "__version__",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'pathfuse' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)
+
+
+if TYPE_CHECKING:  # what the names are, for type checkers and IDEs
+    from pathfuse.api import plan
+    from pathfuse.grid import GridMap
+    from pathfuse.io import (
+        load_map,
+        map_from_spec,
+        read_image,
+        read_movingai,
+        read_npy,
+        read_ros_map,
+        read_rows_yaml,
+        read_scen,
+        write_movingai,
+        write_ros_map,
+    )
+    from pathfuse.planners.registry import (
+        REGISTRY,
+        PlannerSpec,
+        get_planner,
+        planner_names,
+        register_function,
+    )
+    from pathfuse.problem import Problem
+    from pathfuse.result import (
+        Budget,
+        ConfigError,
+        MapError,
+        MapFormatError,
+        PathfuseError,
+        PlanningFailed,
+        PlanResult,
+        QueryError,
+        Status,
+    )
+    from pathfuse.world.episode import Episode, simulate
+    from pathfuse.world.scenario import load_scenario
+    from pathfuse.world.world import World

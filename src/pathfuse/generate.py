@@ -38,7 +38,6 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import ndimage
 
 from pathfuse.grid import GridMap
 from pathfuse.result import ConfigError, MapError
@@ -241,6 +240,8 @@ def random_map(
         occ[chosen] = True
         occ = occ.reshape(shape)
         if pairs:
+            from scipy import ndimage
+
             labels, _ = ndimage.label(~occ)
             if any(labels[a] != labels[b] for a, b in pairs):
                 continue

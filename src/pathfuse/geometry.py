@@ -36,8 +36,12 @@ import math
 
 from numba import njit
 
-__all__ = ["segment_box_distance", "segment_is_clear", "point_box_distance",
+__all__ = ["MARGIN_FRAC", "segment_box_distance", "segment_is_clear", "point_box_distance",
            "point_segment_distance"]
+
+#: Clearance every move keeps from occupied squares beyond the robot radius, in cells: a
+#: safe robot never *touches* a square (the metrics count a touch as a collision).
+MARGIN_FRAC = 1e-6
 
 
 @njit(cache=True, inline="always")

@@ -165,7 +165,7 @@ class Problem:
             from pathfuse.geometry import segment_is_clear
 
             ox, oy = g.origin
-            from pathfuse.field.motion import MARGIN_FRAC
+            from pathfuse.geometry import MARGIN_FRAC
 
             # the clearance every controller keeps (the radius plus a sliver), so that a
             # robot allowed to start or stop here can also move away or arrive

@@ -9,10 +9,13 @@ subclass of :class:`PathfuseError` whose message names the file, key or value.
 from __future__ import annotations
 
 import enum
+import math
+import numbers
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:  # numpy is imported on first use: this module is on the CLI's start-up path
+    import numpy as np
 
 __all__ = [
     "Status",
@@ -91,20 +94,19 @@ class Budget:
     time_limit_s: float | None = None
 
     def __post_init__(self) -> None:
-        if self.max_iterations is not None and (
-            not isinstance(self.max_iterations, (int, np.integer)) or self.max_iterations < 1
-        ):
-            raise ConfigError(
-                f"max_iterations must be a positive integer, got {self.max_iterations!r}"
-            )
-        if self.time_limit_s is not None and not (
-            isinstance(self.time_limit_s, (int, float)) and np.isfinite(self.time_limit_s)
-            and self.time_limit_s > 0
-        ):
-            raise ConfigError(f"time_limit_s must be a positive number, got {self.time_limit_s!r}")
+        m = self.max_iterations
+        if m is not None and (isinstance(m, bool) or not isinstance(m, numbers.Integral)
+                              or m < 1):
+            raise ConfigError(f"max_iterations: must be a positive integer, got {m!r}")
+        t = self.time_limit_s
+        if t is not None and (isinstance(t, bool) or not isinstance(t, numbers.Real)
+                              or not math.isfinite(float(t)) or t <= 0):
+            raise ConfigError(f"time_limit_s: must be a positive number, got {t!r}")
 
 
 def _empty_path() -> np.ndarray:
+    import numpy as np
+
     return np.zeros((0, 2), dtype=np.float64)
 
 
@@ -169,6 +171,8 @@ class PlanResult:
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (path as a list of ``[x, y]``)."""
+        import numpy as np
+
         return {
             "planner": self.planner,
             "status": self.status.name,
@@ -184,9 +188,11 @@ class PlanResult:
 def path_length(path: np.ndarray) -> float:
     """Sum of segment lengths of an (N, 2) path; 0 for fewer than two points.
 
-    >>> path_length(np.array([[0.0, 0.0], [3.0, 4.0], [3.0, 5.0]]))
+    >>> path_length([[0.0, 0.0], [3.0, 4.0], [3.0, 5.0]])
     6.0
     """
+    import numpy as np
+
     p = np.asarray(path, dtype=np.float64)
     if p.shape[0] < 2:
         return 0.0

@@ -17,9 +17,6 @@ The run **kind** selects the executor (:data:`KINDS`): ``"static"`` plans with
 
 from __future__ import annotations
 
-import hashlib
-import importlib
-import importlib.util
 import json
 import math
 import os
@@ -29,19 +26,19 @@ import threading
 import time
 import traceback
 from collections import OrderedDict
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from datetime import datetime, timezone
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["execute_batch", "execute_run", "ensure_imports", "KINDS", "clear_caches"]
+from pathfuse.bench.plugins import ensure_imports
+
+__all__ = ["execute_batch", "execute_run", "KINDS", "clear_caches"]
 
 _MAP_CACHE_SIZE = 8
 _MAPS: OrderedDict[Any, Any] = OrderedDict()
 _REFS: OrderedDict[Any, tuple[float | None, str | None]] = OrderedDict()
-_IMPORTED: set[str] = set()
 _LOCK = threading.RLock()  # Dask workers may run several threads
 
 
@@ -56,35 +53,6 @@ def _lru_put(cache: OrderedDict[Any, Any], key: Any, value: Any, size: int) -> N
     cache.move_to_end(key)
     while len(cache) > size:
         cache.popitem(last=False)
-
-
-def ensure_imports(imports: Sequence[str]) -> None:
-    """Import plug-in modules (names or ``.py`` paths) once per process."""
-    for imp in imports:
-        if imp in _IMPORTED:
-            continue
-        if imp.endswith(".py") and not Path(imp).is_file():
-            # a Dask worker on another machine: the client uploaded the file
-            importlib.import_module(Path(imp).stem)
-        elif imp.endswith(".py"):
-            path = Path(imp).resolve()
-            digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
-            mod_name = "pathfuse_plugin_" + "".join(
-                c if c.isalnum() else "_" for c in path.stem) + f"_{digest}"
-            if mod_name not in sys.modules:
-                spec = importlib.util.spec_from_file_location(mod_name, path)
-                if spec is None or spec.loader is None:
-                    raise ImportError(f"cannot import {path}")
-                mod = importlib.util.module_from_spec(spec)
-                sys.modules[mod_name] = mod
-                try:
-                    spec.loader.exec_module(mod)
-                except BaseException:
-                    del sys.modules[mod_name]
-                    raise
-        else:
-            importlib.import_module(imp)
-        _IMPORTED.add(imp)
 
 
 # --------------------------------------------------------------------------- batch
@@ -125,7 +93,7 @@ def execute_run(group: Mapping[str, Any], run: Mapping[str, Any],
     row["memory"] = _peak_rss_mb()
     row["host"] = socket.gethostname()
     row["worker"] = _worker_name()
-    from pathfuse import __version__
+    from pathfuse._version import __version__
 
     row["pathfuse_version"] = __version__
     return row
@@ -170,7 +138,7 @@ def _grid_locked(group: Mapping[str, Any]) -> Any:
         return _MAPS[key]
     grid = group.get("grid")
     if grid is None:
-        from pathfuse.bench.experiment import load_map
+        from pathfuse.bench.spec import load_map
 
         grid = load_map(group["map_spec"], group.get("base_dir") or ".")
     _lru_put(_MAPS, key, grid, _MAP_CACHE_SIZE)
@@ -271,9 +239,9 @@ def _reference(group: Mapping[str, Any], run: Mapping[str, Any], pgrid: Any,
     with _LOCK:
         if key in _REFS:
             return _REFS[key]
-    import pathfuse
+    from pathfuse.api import plan
 
-    res = pathfuse.plan(pgrid, start, goal, planner=ref["planner"],
+    res = plan(pgrid, start, goal, planner=ref["planner"],
                         robot_radius_m=float(run["robot_radius_m"]),
                         budget=_budget(run["limits"]),
                         **_plan_params(ref["planner"], ref.get("params") or {}))
@@ -363,12 +331,12 @@ def _path_blob(path: np.ndarray) -> bytes:
 def run_static(group: Mapping[str, Any], run: Mapping[str, Any],
                store_paths: bool) -> dict[str, Any]:
     """Plan one static query and measure it (the ``"static"`` kind)."""
-    import pathfuse
+    from pathfuse.api import plan
 
     grid = _grid(group)
     radius = float(run["robot_radius_m"])
     start, goal = _query_points(group, run, _cspace(grid, radius))
-    res = pathfuse.plan(grid, start, goal, planner=run["planner"], robot_radius_m=radius,
+    res = plan(grid, start, goal, planner=run["planner"], robot_radius_m=radius,
                         budget=_budget(run["limits"]),
                         **_plan_params(run["planner"], run["params"]))
     path = np.asarray(res.path, dtype=float).reshape(-1, 2)
@@ -401,7 +369,7 @@ def run_static(group: Mapping[str, Any], run: Mapping[str, Any],
 # --------------------------------------------------------------------------- dynamic runs
 def _scenario(group: Mapping[str, Any]) -> Any:
     """The group's dynamic scenario, loaded once per process."""
-    from pathfuse.bench.experiment import load_dynamic
+    from pathfuse.bench.spec import load_dynamic
 
     key = (group["map_key"], "scenario")
     with _LOCK:

@@ -352,7 +352,7 @@ class ResultStore:
             self.conn.execute("UPDATE experiments SET runcount = ?, timelimit = ?, setup = ? "
                               "WHERE id = ?", (runcount, timelimit, setup, row[0]))
             return int(row[0])
-        from pathfuse import __version__
+        from pathfuse._version import __version__
 
         cur = self.conn.execute(
             "INSERT INTO experiments (name, totaltime, timelimit, memorylimit, runcount, "
@@ -442,7 +442,7 @@ class ResultStore:
 
     # ---------------------------------------------------------------- sessions
     def start_session(self, **fields: Any) -> int:
-        from pathfuse import __version__
+        from pathfuse._version import __version__
 
         fields = {"started_at": _now(), "state": "running", "host": socket.gethostname(),
                   "pathfuse_version": __version__, "python": platform.python_version(),

@@ -32,7 +32,7 @@ import math
 
 from numba import njit
 
-from pathfuse.geometry import segment_is_clear
+from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 
 __all__ = [
     "MARGIN_FRAC",
@@ -43,9 +43,6 @@ __all__ = [
     "safe_step",
     "straight_move",
 ]
-
-#: Clearance kept from occupied squares beyond the robot radius, in cells.
-MARGIN_FRAC = 1e-6
 
 # safe_step outcomes
 HOW_BLOCKED = 0

@@ -121,8 +121,20 @@ class Controller:
         self.dt = dt
         self.max_speed = max_speed
         self.online = dt is not None
-        self.global_path: np.ndarray | None = None if plan is None else plan.waypoints
+        self._global_path: np.ndarray | None = None
         self.failure: tuple[Status, str] | None = None
+
+    @property
+    def global_path(self) -> np.ndarray | None:
+        """The path the controller currently follows (the global plan's waypoints until a
+        replanning controller sets another)."""
+        if self._global_path is None and self.plan is not None:
+            self._global_path = self.plan.waypoints
+        return self._global_path
+
+    @global_path.setter
+    def global_path(self, path: np.ndarray | None) -> None:
+        self._global_path = path
 
     def run(self, deadline: float | None) -> Outcome:  # pragma: no cover - abstract
         """Drive to the goal on the static map (``deadline``: a ``perf_counter`` value)."""

@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -64,6 +65,8 @@ class GlobalPlan:
         ``(row, col)`` from the start cell to the goal cell.
     points : (N, 2) float array
         Their centres (metres).
+    problem : Problem
+        The problem planned (for :attr:`waypoints`).
     waypoints : (M, 2) float array
         What a controller follows: the start, the centres, the goal.
     length_m : float
@@ -80,7 +83,7 @@ class GlobalPlan:
     status: Status
     cells: np.ndarray = field(default_factory=lambda: _NO_CELLS)
     points: np.ndarray = field(default_factory=lambda: _NO_POINTS)
-    waypoints: np.ndarray = field(default_factory=lambda: _NO_POINTS)
+    problem: Problem | None = field(default=None, repr=False)
     length_m: float = math.inf
     expansions: int = 0
     time_s: float = 0.0
@@ -91,6 +94,13 @@ class GlobalPlan:
     @property
     def success(self) -> bool:
         return self.status is Status.SUCCESS
+
+    @cached_property
+    def waypoints(self) -> np.ndarray:
+        """What a controller follows (computed on first use: ``astar`` never needs it)."""
+        if self.problem is None or not self.success:
+            return _NO_POINTS
+        return _waypoints(self.problem, self.points)
 
 
 def snap_cell(occ: np.ndarray, grid: GridMap, p: tuple[float, float],
@@ -175,8 +185,12 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
                    f"({res.expansions} expansions)")
         return GlobalPlan(res.status, expansions=res.expansions, time_s=elapsed, message=msg,
                           heuristic=heuristic, corner_cutting=corner_cutting)
-    points = grid.cell_to_world(res.cells)
-    return GlobalPlan(Status.SUCCESS, res.cells, points, _waypoints(problem, points),
+    cells = res.cells
+    points = np.empty((cells.shape[0], 2))
+    ox, oy = grid.origin
+    points[:, 0] = ox + (cells[:, 1] + 0.5) * grid.resolution
+    points[:, 1] = oy + (cells[:, 0] + 0.5) * grid.resolution
+    return GlobalPlan(Status.SUCCESS, cells, points, problem,
                       res.cost * grid.resolution, res.expansions, elapsed,
                       f"path through {len(res.cells)} cells, {res.cost * grid.resolution:.6g} m, "
                       f"{res.expansions} expansions", heuristic, corner_cutting)

@@ -26,7 +26,7 @@ def cold_kernels(spec: Any) -> list[str]:
     """Names of the kernels ``spec`` (a PlannerSpec) runs that numba must still compile."""
     kernels: list[Any] = []
     if spec.uses_astar:
-        from pathfuse.search.astar import _astar_kernel
+        from pathfuse.search.kernel import _astar_kernel
 
         kernels.append(_astar_kernel)
     if spec.controller is not None:

@@ -1,0 +1,208 @@
+"""Identities of a sweep: canonical JSON, run keys, seeds, limits and map families.
+
+The run key of a run is the SHA-256 of the canonical JSON of its full
+parameters; the result store skips runs whose key it holds, which is what
+makes a sweep resumable (:mod:`pathfuse.bench.experiment`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import hashlib
+import json
+import math
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pathfuse.result import Budget, ConfigError
+
+KEY_VERSION = 1
+"""Bumped only if the meaning of a run key changes (it never silently does)."""
+
+GENERATED_FAMILIES = ("paper", "random")
+"""Map families drawn from a seed; without an explicit seed they take the run's."""
+FILE_FAMILIES = ("movingai", "ros", "image", "npy")
+"""Map families read from a file (path relative to the experiment file)."""
+INLINE_FAMILIES = ("rows",)
+"""Maps written inline in the experiment."""
+ALL_FAMILIES = GENERATED_FAMILIES + FILE_FAMILIES + INLINE_FAMILIES
+
+_TOP_KEYS = ("name", "description", "seeds", "limits", "robot_radius_m", "reference",
+             "store_paths", "imports", "maps", "planners")
+_MAP_KEYS = ("name", "map", "start", "goal", "queries", "scen", "lines", "seeds",
+             "robot_radius_m", "dynamic")
+_PLANNER_KEYS = ("name", "label", "params", "limits", "kinds")
+_LIMIT_KEYS = ("time_limit_s", "max_iterations")
+
+
+# --------------------------------------------------------------------------- helpers
+def canonical_json(obj: Any) -> str:
+    """Canonical JSON: sorted keys, no spaces, shortest float repr, no NaN.
+
+    >>> canonical_json({"b": 1.0, "a": [1, (2, 3)], "c": np.float64(0.1)})
+    '{"a":[1,[2,3]],"b":1.0,"c":0.1}'
+    """
+    return json.dumps(_plain(obj), sort_keys=True, separators=(",", ":"), allow_nan=False,
+                      ensure_ascii=True)
+
+
+def _plain(obj: Any) -> Any:
+    """Convert numpy scalars/arrays, tuples and paths into plain JSON types."""
+    if isinstance(obj, Mapping):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _plain(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return float(obj)
+    if isinstance(obj, os.PathLike):
+        return os.fspath(obj)
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return _plain(dataclasses.asdict(obj))
+    if isinstance(obj, enum.Enum):
+        return str(obj.name)
+    return obj
+
+
+def run_key(payload: Mapping[str, Any]) -> str:
+    """SHA-256 hex digest of the canonical JSON of ``payload``.
+
+    >>> run_key({"b": 2, "a": 1}) == run_key({"a": 1, "b": 2})
+    True
+    >>> len(run_key({"a": 1}))
+    64
+    """
+    return hashlib.sha256(canonical_json(payload).encode("ascii")).hexdigest()
+
+
+def _is_int(v: Any) -> bool:
+    return isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_))
+
+
+def _is_num(v: Any) -> bool:
+    return (_is_int(v) or isinstance(v, (float, np.floating))) and math.isfinite(float(v))
+
+
+def _short(v: Any, n: int = 60) -> str:
+    s = repr(v)
+    return s if len(s) <= n else s[: n - 3] + "..."
+
+
+_DIGESTS: dict[tuple[str, int, int], str] = {}
+
+
+def file_digest(path: Path) -> str:
+    """First 16 hex digits of the SHA-256 of a file (cached by path, size, mtime)."""
+    st = path.stat()
+    k = (str(path), st.st_size, st.st_mtime_ns)
+    if k not in _DIGESTS:
+        h = hashlib.sha256()
+        with open(path, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                h.update(chunk)
+        _DIGESTS[k] = h.hexdigest()[:16]
+    return _DIGESTS[k]
+
+
+# --------------------------------------------------------------------------- seeds
+def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
+    """Seeds from an int count, a list, ``"a:b"`` / ``"a,b,c"`` or ``{start, count}``.
+
+    >>> parse_seeds(3), parse_seeds([5, 1]), parse_seeds("2:5"), parse_seeds("7,8")
+    ((0, 1, 2), (5, 1), (2, 3, 4), (7, 8))
+    >>> parse_seeds({"start": 10, "count": 2})
+    (10, 11)
+    >>> parse_seeds(-1)
+    Traceback (most recent call last):
+    ...
+    pathfuse.result.ConfigError: seeds: a seed count must be >= 1, got -1
+    """
+    def bad(msg: str) -> ConfigError:
+        return ConfigError(f"{where}: {msg}")
+
+    if _is_int(value):
+        if value < 1:
+            raise bad(f"a seed count must be >= 1, got {value}")
+        return tuple(range(int(value)))
+    if isinstance(value, str):
+        text = value.strip()
+        try:
+            if ":" in text:
+                a, b = (int(t) for t in text.split(":"))
+                seeds = tuple(range(a, b))
+            else:
+                seeds = tuple(int(t) for t in text.split(",") if t.strip())
+        except ValueError:
+            raise bad(f"expected 'A:B', 'A,B,C' or a count, got {value!r}") from None
+        if not seeds:
+            raise bad(f"{value!r} holds no seed")
+        if min(seeds) < 0:
+            raise bad(f"seeds must be >= 0, got {value!r}")
+        return seeds
+    if isinstance(value, Mapping):
+        unknown = set(value) - {"start", "count"}
+        if unknown or "count" not in value:
+            raise bad(f"expected {{start: A, count: N}}, got {_short(dict(value))}")
+        start, count = value.get("start", 0), value["count"]
+        if not _is_int(start) or start < 0:
+            raise bad(f"start must be an integer >= 0, got {start!r}")
+        if not _is_int(count) or count < 1:
+            raise bad(f"count must be an integer >= 1, got {count!r}")
+        return tuple(range(int(start), int(start) + int(count)))
+    if isinstance(value, (list, tuple)):
+        if not value:
+            raise bad("the seed list is empty")
+        for i, s in enumerate(value):
+            if not _is_int(s) or s < 0:
+                raise ConfigError(f"{where}[{i}]: a seed must be an integer >= 0, got {s!r}")
+        if len(set(value)) != len(value):
+            raise bad("the seed list repeats a seed")
+        return tuple(int(s) for s in value)
+    raise bad(f"expected a count, a list of integers, 'A:B' or {{start, count}}, got {value!r}")
+
+
+# --------------------------------------------------------------------------- entries
+@dataclass(frozen=True)
+class Limits:
+    """Per-run limits (become a :class:`pathfuse.Budget`)."""
+
+    time_limit_s: float | None = None
+    max_iterations: int | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"time_limit_s": self.time_limit_s, "max_iterations": self.max_iterations}
+
+    def budget(self) -> Budget:
+        return Budget(max_iterations=self.max_iterations, time_limit_s=self.time_limit_s)
+
+
+def _parse_limits(value: Any, where: str, base: Limits | None = None) -> Limits:
+    base = base or Limits()
+    if value is None:
+        return base
+    if not isinstance(value, Mapping):
+        raise ConfigError(f"{where}: expected a mapping {{time_limit_s, max_iterations}}, "
+                          f"got {_short(value)}")
+    for k in value:
+        if k not in _LIMIT_KEYS:
+            raise ConfigError(f"{where}.{k}: unknown limit; use one of {', '.join(_LIMIT_KEYS)}")
+    t = value.get("time_limit_s", base.time_limit_s)
+    m = value.get("max_iterations", base.max_iterations)
+    if t is not None and (not _is_num(t) or float(t) <= 0):
+        raise ConfigError(f"{where}.time_limit_s: must be a number > 0, got {t!r}")
+    if m is not None and (not _is_int(m) or m < 1):
+        raise ConfigError(f"{where}.max_iterations: must be an integer >= 1, got {m!r}")
+    return Limits(None if t is None else float(t), None if m is None else int(m))
+
+

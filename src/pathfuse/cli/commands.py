@@ -1,0 +1,376 @@
+"""The commands of the ``pathfuse`` command line: each parses its options and calls the library."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+from pathfuse.cli.args import (
+    EXIT_FAIL,
+    CliError,
+    _load_map,
+    parse_params,
+    parse_planner_list,
+    parse_planner_params,
+    parse_point,
+    parse_speed,
+)
+
+
+# --------------------------------------------------------------------------- commands
+def cmd_plan(args: argparse.Namespace) -> int:
+    import pathfuse
+    from pathfuse.generate import PAPER_GOAL, PAPER_START
+
+    grid = _load_map(args)
+    is_paper = str(args.map).lower() == "paper"
+    if args.start is None or args.goal is None:
+        if not is_paper:
+            raise CliError("--start and --goal are required unless --map paper")
+    start = parse_point(args.start, "--start") if args.start else PAPER_START
+    goal = parse_point(args.goal, "--goal") if args.goal else PAPER_GOAL
+    params = parse_params(args.param)
+    budget = pathfuse.Budget(time_limit_s=args.time_limit) if args.time_limit else None
+    _warm_with_notice(args.planner)
+    result = pathfuse.plan(grid, start, goal, planner=args.planner, budget=budget,
+                           robot_radius_m=args.robot_radius, **params)
+    if args.plot:
+        from pathfuse.viz import plot_plan
+
+        plot_plan(
+            grid, result, start, goal, args.plot,
+            title=f"{grid.name}: {args.planner} {result.status.name} {result.length:.3f} m",
+            astar_points=result.info.get("astar_path"),
+        )
+    if args.json:
+        d = result.to_dict()
+        d["map"] = grid.name
+        d["start"], d["goal"] = list(start), list(goal)
+        print(json.dumps(d))
+    else:
+        print(f"map       {grid.name}  ({grid.width} x {grid.height} cells, {grid.resolution:g} m)")
+        print(f"planner   {result.planner}")
+        print(f"status    {result.status.name}  {result.message}")
+        print(f"length    {result.length:.4f} m  ({len(result.path)} points)")
+        print(f"time      {result.time_s * 1e3:.3f} ms")
+        if result.expansions:
+            print(f"expanded  {result.expansions}")
+        if result.iterations:
+            print(f"steps     {result.iterations}")
+        if args.plot:
+            print(f"figure    {args.plot}")
+    return 0 if result.success else EXIT_FAIL
+
+
+def cmd_scen(args: argparse.Namespace) -> int:
+    import pathfuse
+    from pathfuse.io import read_movingai, read_scen
+
+    grid = read_movingai(args.map)
+    problems = read_scen(args.scen, grid)
+    if args.limit:
+        problems = problems[: args.limit]
+    n_ok = n_bad = 0
+    total_t = 0.0
+    worst: list[str] = []
+    for p in problems:
+        r = pathfuse.plan(grid, p.start, p.goal, planner="astar", heuristic=args.heuristic)
+        total_t += r.time_s
+        ok = r.success and abs(r.length - p.optimal_length) <= args.tol * max(1.0, p.optimal_length)
+        if ok:
+            n_ok += 1
+        else:
+            n_bad += 1
+            if len(worst) < 10:
+                worst.append(
+                    f"  line {p.line}: expected {p.optimal_length:.8f}, got "
+                    f"{r.length:.8f} ({r.status.name})"
+                )
+    n = n_ok + n_bad
+    print(f"{Path(args.scen).name}: {n_ok}/{n} lines match the optimal length "
+          f"(rel. tol {args.tol:g}); A* time {total_t:.3f} s, "
+          f"{1e3 * total_t / max(n, 1):.3f} ms/query")
+    for line in worst:
+        print(line)
+    return 0 if n_bad == 0 else EXIT_FAIL
+
+
+def _warm_with_notice(planner: str) -> None:
+    """Compile the planner's kernels now, saying so first when numba's cache is cold."""
+    from pathfuse.planners.registry import get_planner
+    from pathfuse.planners.run import warm
+
+    def notice() -> None:
+        print("pathfuse: compiling planner kernels (first run only; cached afterwards)",
+              file=sys.stderr, flush=True)
+
+    warm(get_planner(planner), notify=notice)
+
+
+def planner_table() -> dict[str, Any]:
+    """Every registered planner as JSON-ready data (what ``pathfuse planners --json`` prints)."""
+    import dataclasses
+
+    from pathfuse.planners.registry import REGISTRY, planner_names
+    from pathfuse.validate import param_spec
+
+    out: dict[str, Any] = {}
+    for n in planner_names():
+        spec = REGISTRY[n]
+        params = []
+        for f in dataclasses.fields(spec.params_cls):
+            ps = param_spec(f)
+            default = getattr(spec.params_cls(), f.name)
+            params.append({
+                "name": f.name, "default": default,
+                "kind": ps.kind if ps else "", "unit": ps.unit if ps else "",
+                "accepts": ps.describe() if ps else "", "help": ps.help if ps else "",
+            })
+        ctrl = getattr(spec.controller, "label", "") if spec.controller else ""
+        out[n] = {"description": spec.description, "offline": spec.offline,
+                  "online": spec.online, "global_planner": spec.global_planner,
+                  "controller": ctrl or None, "aliases": list(spec.aliases),
+                  "params": params}
+    return out
+
+
+def cmd_planners(args: argparse.Namespace) -> int:
+    table = planner_table()
+    if args.json:
+        print(json.dumps(table))
+        return 0
+    for name, d in table.items():
+        runs = " and ".join(k for k in ("offline", "online") if d[k])
+        also = f"; also called {', '.join(d['aliases'])}" if d["aliases"] else ""
+        parts = ["global planner: A*" if d["global_planner"] == "astar" else "",
+                 f"controller: {d['controller']}" if d["controller"] else "a plug-in function"]
+        print(f"{name}  ({'; '.join(x for x in parts if x)}; runs {runs}{also})")
+        print(f"  {d['description']}")
+        if args.params:
+            for p in d["params"]:
+                unit = f" {p['unit']}" if p["unit"] and p["default"] is not None else ""
+                print(f"    {p['name']} = {p['default']!r}{unit}  ({p['accepts']}): {p['help']}")
+        else:
+            shown = ", ".join(f"{p['name']}={p['default']!r}" for p in d["params"])
+            print(f"  parameters: {shown}")
+    if not args.params:
+        print("\n'pathfuse planners --params' explains every parameter (unit, range, meaning).")
+    return 0
+
+
+def _study_db(out: str) -> Path:
+    """The result store of a preset study: ``OUT/study.db`` (the folder is created)."""
+    folder = Path(out).expanduser()
+    if folder.exists() and not folder.is_dir():
+        raise CliError(f"--out: {folder} exists and is not a folder")
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder / "study.db"
+
+
+def cmd_paper(args: argparse.Namespace) -> int:
+    from pathfuse.studies.paper import PaperConfig, run_paper, summary_rows, write_paper_outputs
+
+    cfg = PaperConfig(
+        n_seeds=args.seeds, first_seed=args.first_seed,
+        figure_seed=args.seed if args.seed is not None else args.first_seed,
+        step_m=args.step,
+    )
+    if not cfg.first_seed <= cfg.figure_seed < cfg.first_seed + cfg.n_seeds:
+        raise CliError(
+            f"--seed {cfg.figure_seed} is not among the maps run "
+            f"({cfg.first_seed}..{cfg.first_seed + cfg.n_seeds - 1})"
+        )
+    for name in cfg.planners:
+        _warm_with_notice(name)
+    run = run_paper(cfg, progress=False if args.quiet else None, workers=args.workers,
+                    db_path=_study_db(args.out))
+    files = write_paper_outputs(run, args.out)
+    n_runs = len(run.records)
+    sm = run.summary
+    print(f"{n_runs} runs on {cfg.n_seeds} maps: {sm.ran} run now in {run.wall_s:.2f} s "
+          f"({sm.runs_per_s:.0f} runs/s, {sm.workers} worker{'s' if sm.workers != 1 else ''})"
+          + (f", {sm.skipped} already in {sm.db_path}" if sm.skipped else ""))
+    print(f"{'planner':<8} {'success':>12} {'length mean':>12} {'R_length':>10} {'time mean':>11}")
+    for r in summary_rows(run):
+        rl = "-" if r["planner"] == "fusion" else f"{100 * r['r_length_mean']:+.2f}%"
+        print(f"{r['planner']:<8} {r['successes']:>5}/{r['maps']:<6} "
+              f"{r['length_mean_m']:>11.4f}m {rl:>10} {1e3 * r['time_mean_s']:>9.3f}ms")
+    for path in files.values():
+        print(f"wrote {path}")
+    return 0
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    from pathfuse.world import load_scenario, simulate
+
+    out = args.gif or args.mp4
+    fmt = "gif" if args.gif else "mp4" if args.mp4 else None
+    if out is not None:
+        from pathfuse.viz.animate import animate_episode, require_ffmpeg
+
+        if fmt == "mp4":
+            require_ffmpeg()  # before simulating: fail fast, in one line
+        parent = Path(out).expanduser().resolve().parent
+        if not parent.is_dir():
+            raise CliError(f"--{fmt}: the folder {parent} does not exist")
+    sc = load_scenario(args.scenario)
+    params = parse_params(args.param)
+    if args.planner is None or args.planner == sc.planner.name:
+        # the scenario's own planner keeps the scenario's parameters (--param overrides them)
+        choice = {"name": args.planner or sc.planner.name,
+                  "params": {**dict(sc.planner.params), **params}}
+    else:
+        choice = {"name": args.planner, "params": params}
+    ep = simulate(sc, planner=choice, seed=args.seed)
+    anim = None
+    if out is not None:
+        anim = animate_episode(ep, out, format=fmt, fps=args.fps, frame_step=args.frame_step)
+    if args.json:
+        d = ep.to_dict(trajectories=args.trajectories)
+        d["scenario_file"] = str(args.scenario)
+        if anim is not None:
+            d["animation"] = {"path": str(anim.path), "format": anim.format,
+                              "frames": anim.n_frames, "frame_step": anim.frame_step,
+                              "fps": anim.fps, "size_px": list(anim.size_px)}
+        print(json.dumps(d))
+    else:
+        dt = ep.scenario.dt
+        k = len(ep.obstacle_radii)
+        grid = ep.grid
+        print(f"scenario  {sc.name}  ({grid.width} x {grid.height} cells of {grid.resolution:g} m, "
+              f"{k} moving obstacle{'s' if k != 1 else ''})")
+        print(f"planner   {ep.planner}")
+        print(f"status    {ep.status.name}  {ep.message}")
+        ttg = "-" if ep.time_to_goal_s is None else f"{ep.time_to_goal_s:.2f} s"
+        print(f"to goal   {ttg}  ({ep.n_ticks} ticks of {dt:g} s, "
+              f"{ep.times[-1]:.2f} s simulated)")
+        print(f"path      {ep.path_length_m:.3f} m")
+
+        def gap(v: float) -> str:
+            return "-" if not math.isfinite(v) else f"{v:.3f} m"
+
+        print(f"distance  {gap(ep.min_distance_m)} min to any obstacle  (moving: "
+              f"{gap(ep.min_obstacle_distance_m)}, static: {gap(ep.min_static_clearance_m)})")
+        print(f"planning  {1e6 * ep.mean_plan_time_s:.1f} us/tick mean, "
+              f"{1e3 * ep.setup_time_s:.2f} ms setup")
+        if anim is not None:
+            print(f"animation {anim.path}  ({anim.n_frames} frames, every {anim.frame_step} "
+                  f"tick{'s' if anim.frame_step != 1 else ''}, {anim.fps:g} fps = "
+                  f"{anim.speedup(dt):g}x real time, {anim.render_s:.2f} s to write)")
+    return 0 if ep.reached else EXIT_FAIL
+
+
+def cmd_dynamic(args: argparse.Namespace) -> int:
+    from pathfuse.studies.dynamic import (
+        DynamicConfig,
+        run_dynamic,
+        success_pivot,
+        summary_rows,
+        write_dynamic_outputs,
+    )
+
+    cfg = DynamicConfig(
+        n_seeds=args.seeds, moving=tuple(args.moving), speed_range=parse_speed(args.speed),
+        planners=parse_planner_list(args.planners), seed=args.seed,
+        params=parse_planner_params(args.param),
+    )
+    for name in cfg.planners:
+        _warm_with_notice(name)
+    run = run_dynamic(cfg, progress=False if args.quiet else None, workers=args.workers,
+                      db_path=_study_db(args.out))
+    files = write_dynamic_outputs(run, args.out)
+    print(f"{len(run.records)} episodes ({len(cfg.planners)} planners x {len(cfg.moving)} disc "
+          f"counts x {cfg.n_seeds} scenarios) in {run.wall_s:.2f} s "
+          f"({run.episodes_per_s:.1f} episodes/s, {run.workers} worker"
+          f"{'s' if run.workers != 1 else ''})")
+    rows = summary_rows(run)
+    for title, key in (("success rate [95% CI]", "reached"),
+                       ("collision rate [95% CI]", "collision")):
+        table = success_pivot(rows, key)
+        widths = [max(len(r[i]) for r in table) for i in range(len(table[0]))]
+        print(f"\n{title}")
+        for r in table:
+            print("  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip())
+    print()
+    for path in files.values():
+        print(f"wrote {path}")
+    return 0
+
+
+
+def parse_seeds(text: str) -> int | str | list[int]:
+    """``--seeds`` of ``pathfuse bench``: ``"20"`` (seeds 0..19), ``"100:200"`` or ``"3,7,9"``.
+
+    >>> parse_seeds("20"), parse_seeds("5:8"), parse_seeds("3, 7")
+    (20, '5:8', [3, 7])
+    """
+    t = str(text).strip()
+    try:
+        if ":" in t:
+            a, b = (int(x) for x in t.split(":"))
+            if not 0 <= a < b:
+                raise ValueError
+            return f"{a}:{b}"
+        if "," in t:
+            vals = [int(x) for x in t.split(",") if x.strip()]
+            if not vals or min(vals) < 0:
+                raise ValueError
+            return vals
+        n = int(t)
+        if n < 1:
+            raise ValueError
+        return n
+    except ValueError:
+        raise CliError(f"--seeds: expected a count N >= 1, a range A:B with 0 <= A < B, "
+                       f"or a list A,B,C of seeds >= 0, got {text!r}") from None
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from pathfuse.bench import SweepInterrupted, run_bench
+
+    seeds = None if args.seeds is None else parse_seeds(args.seeds)
+    try:
+        summary = run_bench(args.experiment, args.db, seeds=seeds, workers=args.workers,
+                            scheduler=args.scheduler,
+                            progress=False if args.no_progress else None,
+                            retry_errors=args.retry_errors, batch_size=args.batch_size)
+    except SweepInterrupted as exc:
+        print(exc.summary, flush=True)
+        print("pathfuse bench: interrupted; run the same command again to resume",
+              file=sys.stderr)
+        return 130
+    print(summary)
+    return 0 if summary.errors == 0 else EXIT_FAIL
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    from pathfuse.bench.report import build_report
+
+    report = build_report(args.db, reference=args.reference, params=args.param)
+    files = report.write(args.out, embed_images=not args.link_images)
+    study, rows = report.study, report.rows
+    pooled = {r["scope"] for r in rows if r["pooled"]}
+    shown = [r for r in rows if r["scope"] in pooled]
+    n_exp, n_cfg = len({r["experimentid"] for r in study.runs}), len(study.config_ids())
+    print(f"{args.db}: {len(study.runs)} runs, {n_exp} map entr{'y' if n_exp == 1 else 'ies'}, "
+          f"{n_cfg} planner configuration{'' if n_cfg == 1 else 's'}")
+    head = ("scope", "configuration", "runs", "success", "errors", "length mean", "R_length")
+    table = [head]
+    for r in shown:
+        rl = "n/a" if not r["r_length_pairs"] else \
+            f"{100 * r['r_length_mean']:+.2f}% (n={r['r_length_pairs']})"
+        lm = "n/a" if not r["length_n"] else f"{r['length_mean_m']:.3f} m"
+        table.append((r["scope"], r["config"], str(r["runs"]),
+                      f"{100 * r['success_rate']:.1f}%", str(r["errors"]), lm, rl))
+    widths = [max(len(row[i]) for row in table) for i in range(len(head))]
+    for row in table:
+        print("  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
+    print(f"wrote {len(files)} files into {args.out}: report.html, report.md, summary.csv, "
+          "parameters.csv and the figures")
+    return 0
+
+

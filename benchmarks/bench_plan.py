@@ -1,7 +1,9 @@
 """The glue around the A* kernel: what pathfuse.plan() costs beyond the search itself.
 
 For every MovingAI map with a scenario file (the small ones included), on the
-same seeded sample of scenario lines, interleaved query by query:
+same seeded sample of scenario lines, each tool answering the whole sample in
+a row (as a user's loop would), the tools alternating over ``--rounds``
+rounds so that machine noise hits them alike:
 
 * ``plan``: :func:`pathfuse.plan` as a user calls it (query checks, global
   planner, result with the world-coordinate path);
@@ -21,6 +23,7 @@ with the load average and the core count: the machines are shared.
 Usage::
 
     python benchmarks/bench_plan.py [--data DIR] [--queries 100] [--seed 0] [--repeat 2000]
+        [--rounds 5]
 """
 
 from __future__ import annotations
@@ -79,7 +82,7 @@ def tiny(data: Path, repeat: int) -> None:
           f"{1e6 * (pw - kw):.1f} us")
 
 
-def per_map(data: Path, queries: int, seed: int) -> None:
+def per_map(data: Path, queries: int, seed: int, rounds: int) -> None:
     print(f"\n{'map':<32} {'n':>4} {'plan us':>10} {'kernel us':>10} {'plan/kernel':>11} "
           f"{'scipy us':>10} {'scipy/plan':>10}")
     for scen in sorted(data.glob("*.scen")):
@@ -96,19 +99,22 @@ def per_map(data: Path, queries: int, seed: int) -> None:
         csr = build_csr(g.occupied, corner_cutting=False)
         w = g.width
         pathfuse.plan(g, pick[0].start, pick[0].goal)  # buffers, compilation
-        tp, tk, ts = [], [], []
-        for p in pick:
-            tp.append(timed(lambda p=p: pathfuse.plan(g, p.start, p.goal))[0])
-            tk.append(timed(lambda p=p: searcher.search(p.start_cell, p.goal_cell))[0])
 
-            def sp(p=p) -> None:
-                src = p.start_cell[0] * w + p.start_cell[1]
-                _, pred = dijkstra(csr, indices=src, return_predecessors=True)
-                node = p.goal_cell[0] * w + p.goal_cell[1]
-                while node != src and node >= 0:
-                    node = pred[node]
+        def sp(p, csr=csr, w=w) -> None:
+            src = p.start_cell[0] * w + p.start_cell[1]
+            _, pred = dijkstra(csr, indices=src, return_predecessors=True)
+            node = p.goal_cell[0] * w + p.goal_cell[1]
+            while node != src and node >= 0:
+                node = pred[node]
 
-            ts.append(timed(sp)[0])
+        tools = (lambda p, g=g: pathfuse.plan(g, p.start, p.goal),
+                 lambda p, s=searcher: s.search(p.start_cell, p.goal_cell), sp)
+        times: list[list[float]] = [[], [], []]
+        for _ in range(rounds):  # each tool answers the whole sample in a row, as a user's
+            for k, tool in enumerate(tools):  # loop would; the rounds alternate the tools
+                for p in pick:
+                    times[k].append(timed(lambda p=p, tool=tool: tool(p))[0])
+        tp, tk, ts = times
         mp_, mk, ms = (statistics.median(v) for v in (tp, tk, ts))
         print(f"{name:<32} {len(pick):>4} {1e6 * mp_:>10.1f} {1e6 * mk:>10.1f} "
               f"{mp_ / mk:>11.2f} {1e6 * ms:>10.1f} {ms / mp_:>10.1f}")
@@ -120,6 +126,7 @@ def main() -> None:
     ap.add_argument("--queries", type=int, default=100)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--repeat", type=int, default=2000)
+    ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
     if not args.data.is_dir():
         sys.exit(f"no MovingAI data in {args.data} (pass --data)")
@@ -127,7 +134,7 @@ def main() -> None:
           f"{os.getloadavg()[0]:.2f}; python {platform.python_version()}; "
           f"pathfuse from {Path(pathfuse.__file__).parent}")
     tiny(args.data, args.repeat)
-    per_map(args.data, args.queries, args.seed)
+    per_map(args.data, args.queries, args.seed, args.rounds)
     print(f"\nload average at the end: {os.getloadavg()[0]:.2f}")
 
 

@@ -135,20 +135,27 @@ class Problem:
         overlaps an occupied square or the map's edge:
         ``START_/GOAL_OCCUPIED``.
         """
-        for p, cell, what, oob, occ in (
+        g = self.grid
+        h, w = g.occupied.shape
+        occ = g.occupied
+        (sr, sc), (gr, gc) = self.start_cell, self.goal_cell
+        # the common case first: both cells inside, free, and a point robot
+        if 0 <= sr < h and 0 <= sc < w and 0 <= gr < h and 0 <= gc < w and \
+                not occ[sr, sc] and not occ[gr, gc] and self.robot_radius_m == 0:
+            return None
+        for p, cell, what, oob, blocked in (
             (self.start, self.start_cell, "start", Status.START_OUT_OF_BOUNDS,
              Status.START_OCCUPIED),
             (self.goal, self.goal_cell, "goal", Status.GOAL_OUT_OF_BOUNDS, Status.GOAL_OCCUPIED),
         ):
-            g = self.grid
             r, c = cell
-            if not (0 <= r < g.height and 0 <= c < g.width):
+            if not (0 <= r < h and 0 <= c < w):
                 x0, y0, x1, y1 = g.bounds
                 return oob, (f"{what} ({p[0]:g}, {p[1]:g}) is outside the map "
                              f"[{x0:g}, {x1:g}) x [{y0:g}, {y1:g})")
             msg = self._blocked(p, cell, what)
             if msg is not None:
-                return occ, msg
+                return blocked, msg
         return None
 
     def _blocked(self, p: tuple[float, float], cell: tuple[int, int], what: str) -> str | None:

@@ -17,6 +17,7 @@ The run **kind** selects the executor (:data:`KINDS`): ``"static"`` plans with
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -206,11 +207,22 @@ def _query_points(group: Mapping[str, Any], run: Mapping[str, Any],
 
 
 # --------------------------------------------------------------------------- static runs
-def _plan_params(planner: str, params: Mapping[str, Any]) -> dict[str, Any]:
-    """Params from JSON (lists) back to the dataclass defaults' types (tuples)."""
+def _defaults(planner: str) -> dict[str, Any]:
     from pathfuse.planners.registry import get_planner
 
-    defaults = get_planner(planner).defaults()
+    spec = get_planner(planner)
+    hit = _DEFAULTS.get(spec.name)
+    if hit is None or hit[0] is not spec:
+        hit = _DEFAULTS[spec.name] = (spec, spec.defaults())
+    return hit[1]
+
+
+_DEFAULTS: dict[str, tuple[Any, dict[str, Any]]] = {}
+
+
+def _plan_params(planner: str, params: Mapping[str, Any]) -> dict[str, Any]:
+    """Params from JSON (lists) back to the dataclass defaults' types (tuples)."""
+    defaults = _defaults(planner)
     out = {}
     for k, v in params.items():
         d = defaults.get(k)
@@ -242,9 +254,8 @@ def _reference(group: Mapping[str, Any], run: Mapping[str, Any], pgrid: Any,
     from pathfuse.api import plan
 
     res = plan(pgrid, start, goal, planner=ref["planner"],
-                        robot_radius_m=float(run["robot_radius_m"]),
-                        budget=_budget(run["limits"]),
-                        **_plan_params(ref["planner"], ref.get("params") or {}))
+               robot_radius_m=float(run["robot_radius_m"]), budget=_budget(run["limits"]),
+               **_plan_params(ref["planner"], ref.get("params") or {}))
     val = (float(res.length), ref["planner"]) if res.success else (None, ref["planner"])
     with _LOCK:
         _lru_put(_REFS, key, val, 4096)
@@ -278,17 +289,25 @@ def _scalars(d: Mapping[str, Any]) -> dict[str, Any]:
     """The JSON-friendly scalar entries of a dict (numbers, strings, bools)."""
     out: dict[str, Any] = {}
     for k, v in d.items():
-        if isinstance(v, (bool, np.bool_)):
+        t = type(v)
+        if t is float:  # the common cases first
+            out[str(k)] = v if math.isfinite(v) else None
+        elif t is str:
+            out[str(k)] = v
+        elif t is bool or t is int:
+            out[str(k)] = v
+        elif isinstance(v, (bool, np.bool_)):
             out[str(k)] = bool(v)
         elif isinstance(v, (int, np.integer)):
             out[str(k)] = int(v)
         elif isinstance(v, (float, np.floating)):
             out[str(k)] = float(v) if math.isfinite(float(v)) else None
         elif isinstance(v, str):
-            out[str(k)] = v
+            out[str(k)] = str(v)
     return out
 
 
+@functools.lru_cache(maxsize=1024)
 def _is_timing(key: str) -> bool:
     k = key.lower()
     return "time" in k or k.endswith(("_s", "per_s", "_ms", "_us", "_ns")) or "rate" in k

@@ -15,6 +15,7 @@ import multiprocessing as mp
 import os
 import signal
 import sys
+import time
 from collections import deque
 from collections.abc import Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -107,12 +108,26 @@ def _exception_rows(batch: Sequence[Sequence[RunSpec]], exc: BaseException) -> l
 
 
 # --------------------------------------------------------------------------- backends
+SERIAL_FLUSH_S = 0.25
+"""In-process runs are committed in small batches, at least this often (seconds): a kill
+loses at most the runs of the last quarter second, which the same command runs again."""
+
+
 def _run_serial(exp: Experiment, todo: Sequence[RunSpec], sink: Sink) -> None:
-    for group in iter_groups(todo):
-        gp = _group_payload(exp, group)
-        for r in group:
-            row = execute_run(gp, _run_payload(r), store_paths=exp.store_paths)
-            sink.write([row])
+    pending: list[dict[str, Any]] = []
+    last = time.perf_counter()
+    try:
+        for group in iter_groups(todo):
+            gp = _group_payload(exp, group)
+            for r in group:
+                pending.append(execute_run(gp, _run_payload(r), store_paths=exp.store_paths))
+                now = time.perf_counter()
+                if len(pending) >= 256 or now - last >= SERIAL_FLUSH_S:
+                    sink.write(pending)
+                    pending, last = [], now
+    finally:  # Ctrl-C: what finished is stored
+        if pending:
+            sink.write(pending)
 
 
 def _worker_init(imports: Sequence[str]) -> None:

@@ -22,6 +22,7 @@ from pathfuse.bench.keys import (
     KEY_VERSION,
     Limits,
     _is_int,
+    _plain,
     _short,
     canonical_json,
     file_digest,
@@ -156,6 +157,12 @@ class RunSpec:
     """plannerConfigs.settings: canonical JSON of the config's parameters (no run seed)."""
 
 
+def _dumps(plain: Any) -> str:
+    """:func:`canonical_json` of a value already made of JSON types."""
+    return json.dumps(plain, sort_keys=True, separators=(",", ":"), allow_nan=False,
+                      ensure_ascii=True)
+
+
 # --------------------------------------------------------------------------- experiment
 @dataclass(frozen=True)
 class Experiment:
@@ -196,29 +203,42 @@ class Experiment:
         Raises :class:`ConfigError` when the maps or scenario files cannot be
         read (naming ``maps[i]``) or two entries would produce the same run.
         """
+        cached = self.__dict__.get("_runs")
+        if cached is not None:
+            return list(cached)
         runs: list[RunSpec] = []
         seen: dict[str, tuple[int, int]] = {}
-        combos = [(p, p.combinations()) for p in self.planners]
+        # the parts of a payload are made plain (JSON types) once, not once per run: the
+        # payload's JSON is the same as canonical_json of the whole (tested)
+        combos = [(p, [_plain(c) for c in p.combinations()]) for p in self.planners]
+        settings_of: dict[tuple[int, str, int], str] = {}
+        plain_defaults = {(p.index, k): _plain(d) for p in self.planners
+                          for k, d in p.defaults_by_kind.items()}
+        plain_limits = {p.index: _plain(p.limits.as_dict()) for p in self.planners}
         for entry in self.maps:
             applicable = [(p, c) for p, c in combos if entry.kind in p.kinds]
+            reference = _plain(self.reference if entry.kind == "static" else None)
             for seed in entry.seeds:
                 map_portable, map_load, map_key = self._map_identity(entry, seed)
                 for qi, query in enumerate(self._queries(entry, seed)):
-                    problem = {"v": KEY_VERSION, "group": entry.name, "kind": entry.kind,
-                               "map": map_portable, "query": query,
-                               "robot_radius_m": entry.robot_radius_m}
+                    problem = _plain({"v": KEY_VERSION, "group": entry.name,
+                                      "kind": entry.kind, "map": map_portable, "query": query,
+                                      "robot_radius_m": entry.robot_radius_m})
                     problem_key = run_key(problem)[:24]
                     for pe, pcombos in applicable:
-                        defaults = pe.defaults_by_kind[entry.kind]
-                        for combo in pcombos:
+                        defaults = plain_defaults[(pe.index, entry.kind)]
+                        limits = plain_limits[pe.index]
+                        takes_seed = "seed" in pe.fields_by_kind[entry.kind]
+                        for ci, combo in enumerate(pcombos):
                             params = dict(combo)
-                            settings = canonical_json({**defaults, **combo})
-                            if "seed" in pe.fields_by_kind[entry.kind] and "seed" not in params:
+                            sk = (pe.index, entry.kind, ci)
+                            if sk not in settings_of:
+                                settings_of[sk] = canonical_json({**defaults, **combo})
+                            settings = settings_of[sk]
+                            if takes_seed and "seed" not in params:
                                 params["seed"] = int(seed)
                             full = {**defaults, **params}
-                            limits = pe.limits.as_dict()
-                            reference = self.reference if entry.kind == "static" else None
-                            payload = canonical_json({
+                            payload = _dumps({
                                 **problem, "planner": pe.name, "params": full,
                                 "seed": int(seed), "limits": limits, "reference": reference,
                             })
@@ -239,6 +259,7 @@ class Experiment:
                                 map_key=map_key, map_spec=map_load, limits=limits,
                                 robot_radius_m=entry.robot_radius_m, reference=reference,
                                 payload=payload, settings=settings))
+        object.__setattr__(self, "_runs", tuple(runs))  # the same list on every call
         return runs
 
     # -- map identity ------------------------------------------------------

@@ -188,10 +188,19 @@ WALL_CLOCK_COLUMNS: frozenset[str] = frozenset({
 
 _RUN_COLS = [c for c, _, _ in RUN_COLUMNS]
 _INSERT_COLS = [c for c in _RUN_COLS if c != "id"]
+_INSERT_SET = frozenset(_INSERT_COLS)
 
 
 def _q(name: str) -> str:
     return '"' + name.replace('"', '""') + '"'
+
+
+_INSERT_SQL = (
+    f"INSERT INTO runs ({', '.join(_q(c) for c in _INSERT_COLS)}) "
+    f"VALUES ({', '.join('?' for _ in _INSERT_COLS)}) ON CONFLICT(run_key) DO UPDATE SET "
+    + ", ".join(f"{_q(c)} = excluded.{_q(c)}" for c in _INSERT_COLS if c != "run_key")
+    + " WHERE runs.status_name = 'ERROR'")
+"""One run's insert: a new key is stored, a stored ERROR is replaced, anything else kept."""
 
 
 _SCHEMA = f"""
@@ -396,19 +405,14 @@ class ResultStore:
         """
         if not rows:
             return 0
-        cols = ", ".join(_q(c) for c in _INSERT_COLS)
-        marks = ", ".join("?" for _ in _INSERT_COLS)
-        updates = ", ".join(f"{_q(c)} = excluded.{_q(c)}" for c in _INSERT_COLS
-                            if c != "run_key")
-        sql = (f"INSERT INTO runs ({cols}) VALUES ({marks}) ON CONFLICT(run_key) DO UPDATE "
-               f"SET {updates} WHERE runs.status_name = 'ERROR'")
+        sql = _INSERT_SQL
         new = 0
         with self.transaction():
             for row in rows:
                 values = dict(row)
                 values["status"] = self._status_value(str(values.get("status_name")
                                                           or "ERROR"))
-                unknown = set(values) - set(_INSERT_COLS) - {"progress"}
+                unknown = values.keys() - _INSERT_SET - {"progress"}
                 if unknown:
                     raise PathfuseError(f"unknown result column(s): {sorted(unknown)}")
                 cur = self.conn.execute(sql, [_sqlval(values.get(c)) for c in _INSERT_COLS])
@@ -496,7 +500,15 @@ def _split_sql(script: str) -> list[str]:
     return [s.strip() for s in script.split(";") if s.strip()]
 
 
+_NATIVE = frozenset({str, bytes, int, bool, type(None)})
+
+
 def _sqlval(v: Any) -> Any:
+    t = type(v)
+    if t in _NATIVE:  # the common cases, without isinstance
+        return v
+    if t is float:
+        return None if v != v else v  # NaN -> NULL
     if v is None or isinstance(v, (str, bytes, int, float)):
         if isinstance(v, float) and v != v:  # NaN -> NULL
             return None

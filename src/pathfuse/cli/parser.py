@@ -178,8 +178,7 @@ an animation plays in real time unless that takes more than 150 frames, then fas
         "dynamic.md (success, collision, timeout and local-minimum rates with 95% Wilson "
         "intervals, path length and time to goal over the successful episodes, a paired "
         "comparison with the fusion), summary.csv, episodes.csv (one row per episode, nothing "
-        "dropped), paired.csv and success_vs_moving.png.  The defaults (1200 episodes) take "
-        "about 15 s on one core.",
+        "dropped), paired.csv and success_vs_moving.png; its study.db keeps every episode.",
         epilog=_fmt("""
 examples:
   pathfuse dynamic

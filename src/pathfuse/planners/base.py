@@ -69,7 +69,7 @@ class Observed(Protocol):
     obstacles: Any  # positions (M, 2), velocities (M, 2), radii (M,), len()
 
 
-@dataclass(frozen=True)
+@dataclass
 class Outcome:
     """What an offline run of a controller returns (``plan()`` turns it into a PlanResult)."""
 

@@ -40,8 +40,9 @@ from pathfuse.field.motion import MARGIN_FRAC
 from pathfuse.geometry import segment_is_clear
 from pathfuse.grid import GridMap
 from pathfuse.problem import Problem
-from pathfuse.result import Status
-from pathfuse.search.astar import AStarSearcher, get_searcher
+from pathfuse.result import ConfigError, Status
+from pathfuse.search.astar import HEURISTICS, AStarSearcher, get_searcher
+from pathfuse.search.kernel import cell_centres
 
 __all__ = ["GlobalPlan", "plan_global", "route", "snap_cell"]
 
@@ -51,7 +52,7 @@ _NO_CELLS = np.zeros((0, 2), dtype=np.int64)
 _NO_CELLS.setflags(write=False)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(eq=False)
 class GlobalPlan:
     """The outcome of :func:`plan_global`.
 
@@ -148,6 +149,9 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
     time_limit_s : float, optional
         Default: the problem's budget.
     """
+    if heuristic not in HEURISTICS:
+        raise ConfigError(f"heuristic: must be one of {', '.join(map(repr, HEURISTICS))}, "
+                          f"got {heuristic!r}")
     grid = problem.grid
     r = problem.robot_radius_m
     cs = grid.cspace(r)
@@ -170,8 +174,8 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
     budget = problem.budget
     limit = budget.time_limit_s if time_limit_s is None else time_limit_s
     t0 = time.perf_counter()
-    res = searcher.search(sc, gc, heuristic=heuristic, max_expansions=max_expansions,
-                          time_limit_s=limit)
+    # the cells are in bounds and free (the problem and the snapping checked them)
+    res = searcher.search_checked(sc, gc, heuristic, max_expansions, limit)
     elapsed = time.perf_counter() - t0
     if res.status is not Status.SUCCESS:
         if res.status is Status.NO_PATH:
@@ -186,10 +190,8 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
         return GlobalPlan(res.status, expansions=res.expansions, time_s=elapsed, message=msg,
                           heuristic=heuristic, corner_cutting=corner_cutting)
     cells = res.cells
-    points = np.empty((cells.shape[0], 2))
     ox, oy = grid.origin
-    points[:, 0] = ox + (cells[:, 1] + 0.5) * grid.resolution
-    points[:, 1] = oy + (cells[:, 0] + 0.5) * grid.resolution
+    points = cell_centres(cells, ox, oy, grid.resolution)
     return GlobalPlan(Status.SUCCESS, cells, points, problem,
                       res.cost * grid.resolution, res.expansions, elapsed,
                       f"path through {len(res.cells)} cells, {res.cost * grid.resolution:.6g} m, "
@@ -213,13 +215,16 @@ def _waypoints(problem: Problem, centres: np.ndarray) -> np.ndarray:
     if i1 - i0 > 1 and segment_is_clear(centres[i1 - 2, 0], centres[i1 - 2, 1], gx, gy, occ, ox,
                                         oy, res, clear):
         i1 -= 1
-    path = np.empty((i1 - i0 + 2, 2))
-    path[0] = problem.start
-    path[1:-1] = centres[i0:i1]
-    path[-1] = problem.goal
-    keep = np.ones(path.shape[0], dtype=bool)
-    keep[1:] = np.any(np.diff(path, axis=0) != 0.0, axis=1)
-    return np.ascontiguousarray(path[keep])
+    mid = centres[i0:i1]  # distinct cells: a point can repeat only at the two joints
+    head = not (mid[0, 0] == sx and mid[0, 1] == sy)
+    tail = not (mid[-1, 0] == gx and mid[-1, 1] == gy)
+    path = np.empty((mid.shape[0] + head + tail, 2))
+    if head:
+        path[0, 0], path[0, 1] = sx, sy
+    path[int(head):int(head) + mid.shape[0]] = mid
+    if tail:
+        path[-1, 0], path[-1, 1] = gx, gy
+    return path
 
 
 def route(grid: GridMap, start: object, goal: object, robot_radius_m: float = 0.0,

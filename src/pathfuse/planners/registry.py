@@ -103,6 +103,7 @@ class PlannerSpec:
 REGISTRY: dict[str, PlannerSpec] = {}
 _ALIASES: dict[str, str] = {}
 _DEFAULTS: dict[str, Any] = {}
+_BUILT: dict[Any, Any] = {}
 
 
 def register(spec: PlannerSpec) -> PlannerSpec:
@@ -171,9 +172,22 @@ def make_params(spec: PlannerSpec, params: Mapping[str, Any] | None = None,
         if hit is None or type(hit) is not spec.params_cls:
             hit = _DEFAULTS[spec.name] = spec.params_cls()
         return hit
+    try:  # the same parameters again (a sweep, a loop of plan() calls): built once
+        ck = (spec.name, spec.params_cls, key, error,
+              tuple(sorted((k, type(v), v) for k, v in params.items())))
+        hit = _BUILT.get(ck)
+    except TypeError:  # an unhashable value: build it (its check names the problem)
+        ck, hit = None, None
+    if hit is not None:
+        return hit
     from pathfuse.validate import build
 
-    return build(spec.params_cls, params, key or spec.name, error)
+    built = build(spec.params_cls, params, key or spec.name, error)
+    if ck is not None:
+        if len(_BUILT) >= 512:
+            _BUILT.clear()
+        _BUILT[ck] = built
+    return built
 
 
 _LOADED = False

@@ -99,7 +99,7 @@ HEURISTICS = ("euclidean", "octile")
 """Accepted heuristic names."""
 
 # ----------------------------------------------------------------------------- Python API
-@dataclass(frozen=True)
+@dataclass
 class SearchResult:
     """Outcome of :meth:`AStarSearcher.search`.
 
@@ -232,6 +232,15 @@ class AStarSearcher:
                 raise QueryError(f"{what} cell ({r}, {c}) is occupied")
         with self.lock:
             return self._search(sr, sc, gr, gc, heuristic, max_expansions, time_limit_s)
+
+    def search_checked(self, start_cell: tuple[int, int], goal_cell: tuple[int, int],
+                       heuristic: str, max_expansions: int | None,
+                       time_limit_s: float | None) -> SearchResult:
+        """:meth:`search` for cells a :class:`~pathfuse.problem.Problem` has already checked
+        (in bounds and free; the heuristic a known name): the checks are not repeated."""
+        with self.lock:
+            return self._search(start_cell[0], start_cell[1], goal_cell[0], goal_cell[1],
+                                heuristic, max_expansions, time_limit_s)
 
     def _search(self, sr, sc, gr, gc, heuristic, max_expansions, time_limit_s) -> SearchResult:
         t0 = time.perf_counter()

@@ -361,3 +361,14 @@ def _trace(parent, start, goal, wp):
     return out
 
 
+
+
+@njit(cache=True, nogil=True)
+def cell_centres(cells, ox, oy, res):
+    """World ``[x, y]`` of the centres of ``(row, col)`` cells (one call, any length)."""
+    n = cells.shape[0]
+    out = np.empty((n, 2))
+    for i in range(n):
+        out[i, 0] = ox + (cells[i, 1] + 0.5) * res
+        out[i, 1] = oy + (cells[i, 0] + 0.5) * res
+    return out

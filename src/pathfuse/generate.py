@@ -83,7 +83,8 @@ def _cells_of(size: float, resolution: float, axis: str) -> int:
 def _point_cell(grid_shape: tuple[int, int], origin: tuple[float, float], resolution: float,
                 p: object, what: str) -> tuple[int, int]:
     try:
-        x, y = (float(v) for v in p)  # type: ignore[union-attr]
+        # any iterable of two numbers; a TypeError is reported below
+        x, y = (float(v) for v in p)  # type: ignore[attr-defined]
     except (TypeError, ValueError):
         raise MapError(f"{what} must be an (x, y) pair of numbers, got {p!r}") from None
     if not (math.isfinite(x) and math.isfinite(y)):
@@ -236,7 +237,7 @@ def random_map(
     label = name if name is not None else f"random-{width}x{height}-n{count}-s{int(seed)}"
     for attempt in range(1, int(max_attempts) + 1):
         chosen = rng.choice(candidates, size=count, replace=False)
-        occ = np.zeros(n_cells, dtype=bool)
+        occ: np.ndarray = np.zeros(n_cells, dtype=bool)
         occ[chosen] = True
         occ = occ.reshape(shape)
         if pairs:

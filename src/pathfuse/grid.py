@@ -27,10 +27,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from pathfuse.result import MapError
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["GridMap"]
 
@@ -41,7 +45,8 @@ def _as_points(xy: object, what: str = "point") -> np.ndarray:
     if p.ndim == 1:
         p = p.reshape(1, -1)
     if p.ndim != 2 or p.shape[1] != 2:
-        raise MapError(f"{what} must have shape (2,) or (N, 2), got {np.shape(xy)}")
+        shape = np.shape(cast("ArrayLike", xy))  # np.asarray accepted it above
+        raise MapError(f"{what} must have shape (2,) or (N, 2), got {shape}")
     return p
 
 

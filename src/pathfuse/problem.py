@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 from pathfuse.grid import GridMap
 from pathfuse.result import Budget, ConfigError, QueryError, Status
@@ -46,6 +47,8 @@ def as_xy(value: object, what: str) -> tuple[float, float]:
     """
     if isinstance(value, (str, bytes)):
         raise QueryError(f"{what}: must be two numbers (x, y), got {value!r}")
+    x: Any
+    y: Any
     try:
         x, y = value  # type: ignore[misc]
         x = float(x)

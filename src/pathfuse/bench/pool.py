@@ -343,16 +343,16 @@ def _run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: Sink, scheduler: A
                 sink.write(_exception_rows(b, exc))
         # batches that killed workers: one run per task, so only the culprit fails
         if singles:
-            index = {}
+            single_index: dict[Any, RunSpec] = {}
             fs = []
             for r in singles:
                 f = client.submit(execute_batch, _batch_payload(exp, [[r]], grids),
                                   pure=False)
-                index[f] = r
+                single_index[f] = r
                 fs.append(f)
             futures.extend(fs)
             for f in as_completed(fs, loop=client.loop):
-                r = index.pop(f)
+                r = single_index.pop(f)
                 try:
                     sink.write(f.result())
                 except KilledWorker:

@@ -288,7 +288,7 @@ def run_experiment(
     if scheduler is not None:
         _connect_check(scheduler)
     own_store = not isinstance(db_path, ResultStore)
-    store = ResultStore(db_path) if own_store else db_path
+    store = db_path if isinstance(db_path, ResultStore) else ResultStore(db_path)
     summary = SweepSummary(experiment=exp.name, db_path=str(store.path), total=len(runs),
                            workers=nworkers,
                            scheduler=_scheduler_name(scheduler))

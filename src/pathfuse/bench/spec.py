@@ -437,7 +437,7 @@ def load_dynamic(spec: Mapping[str, Any]) -> Any:
     if isinstance(dyn, Mapping) and spec.get("base_dir"):
         d = json.loads(canonical_json(dyn))
         m = d.get("map")
-        if isinstance(m, Mapping):  # relative map files: against the experiment's folder
+        if isinstance(m, dict):  # relative map files: against the experiment's folder
             for fam in FILE_FAMILIES:
                 if isinstance(m.get(fam), str) and not Path(m[fam]).is_absolute():
                     m[fam] = str(Path(spec["base_dir"]) / m[fam])

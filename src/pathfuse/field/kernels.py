@@ -193,7 +193,8 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
         if j < last and math.hypot(x - subs[j, 0], y - subs[j, 1]) <= sub_tol:
             j += 1
             continue
-        buf = _grow(buf, n)
+        if n + 2 > buf.shape[0]:
+            buf = _grow(buf, n)
         if j == last:
             n, done = _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear)
             if done != CODE_RUNNING:
@@ -432,8 +433,9 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
         if idle > idle_cap:
             code = CODE_BLOCKED
             break
-        buf = _grow(buf, n)
-        kbuf = _grow_int(kbuf, n)
+        if n + 2 > buf.shape[0]:
+            buf = _grow(buf, n)
+            kbuf = _grow_int(kbuf, n)
         n, done = _goal_reached(buf, n, x, y, f[F_GX], f[F_GY], f[F_TOL], occ, f[F_OX],
                                 f[F_OY], f[F_RES], f[F_CLEAR])
         if done != CODE_RUNNING:

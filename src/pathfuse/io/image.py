@@ -80,6 +80,7 @@ def load_pixels(
 
     path = Path(path)
     _check_file(path, "image file", context)
+    img: Image.Image  # an ImageFile until converted below
     try:
         with Image.open(path) as im:
             im.load()
@@ -146,7 +147,8 @@ def _resolution(value: object, path: Path) -> float:
 
 def _origin(value: object, path: Path) -> tuple[float, float]:
     try:
-        ox, oy = (float(v) for v in value)  # type: ignore[union-attr]
+        # any iterable of two numbers; a TypeError is reported below
+        ox, oy = (float(v) for v in value)  # type: ignore[attr-defined]
     except (TypeError, ValueError):
         raise MapError(f"{path}: origin must be two numbers (x, y), got {value!r}") from None
     if not (math.isfinite(ox) and math.isfinite(oy)):
@@ -156,7 +158,7 @@ def _origin(value: object, path: Path) -> tuple[float, float]:
 
 def read_image(
     path: str | os.PathLike[str],
-    resolution: float,
+    resolution: float | None,
     origin: tuple[float, float] = (0.0, 0.0),
     threshold: float = 0.5,
     negate: bool = False,
@@ -219,7 +221,7 @@ def read_image(
 
 def read_npy(
     path: str | os.PathLike[str],
-    resolution: float,
+    resolution: float | None,
     origin: tuple[float, float] = (0.0, 0.0),
     name: str | None = None,
 ) -> GridMap:

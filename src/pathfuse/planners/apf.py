@@ -34,7 +34,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -45,6 +45,9 @@ from pathfuse.planners.base import FieldController
 from pathfuse.planners.params import DiscParams, FieldParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["APFParams", "APFController", "SubgoalController", "force_at"]
 
@@ -145,7 +148,7 @@ def force_at(grid: GridMap, xy: object, goal: object, params: APFParams | None =
     for k in range(pts.shape[0]):
         out[k] = apf_force(pts[k, 0], pts[k, 1], gx, gy, p.k_att, p.k_rep, p.rho0_m, p.rho0_m,
                            grid.occupied, ox, oy, grid.resolution)
-    return out[0] if np.ndim(xy) == 1 else out
+    return out[0] if np.ndim(cast("ArrayLike", xy)) == 1 else out
 
 
 register(PlannerSpec(

@@ -63,10 +63,14 @@ def _plain(a: Any) -> np.ndarray:
 class Observed(Protocol):
     """What an online controller reads from an observation (see :class:`pathfuse.world.World`)."""
 
-    tick: int
-    position: np.ndarray
-    velocity: np.ndarray
-    obstacles: Any  # positions (M, 2), velocities (M, 2), radii (M,), len()
+    @property
+    def tick(self) -> int: ...
+    @property
+    def position(self) -> np.ndarray: ...
+    @property
+    def velocity(self) -> np.ndarray: ...
+    @property
+    def obstacles(self) -> Any: ...  # positions (M, 2), velocities (M, 2), radii (M,), len()
 
 
 @dataclass

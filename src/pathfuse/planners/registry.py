@@ -28,9 +28,12 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pathfuse.result import ConfigError
+
+if TYPE_CHECKING:
+    from pathfuse.planners.base import Controller
 
 __all__ = [
     "PlannerSpec",
@@ -71,7 +74,7 @@ class PlannerSpec:
     name: str
     params_cls: type
     description: str
-    controller: type | None = None
+    controller: type[Controller] | None = None
     global_planner: str | None = None
     function: Callable[..., Any] | None = None
     aliases: tuple[str, ...] = ()
@@ -182,7 +185,7 @@ def make_params(spec: PlannerSpec, params: Mapping[str, Any] | None = None,
         return hit
     from pathfuse.validate import build
 
-    built = build(spec.params_cls, params, key or spec.name, error)
+    built: Any = build(spec.params_cls, params, key or spec.name, error)
     if ck is not None:
         if len(_BUILT) >= 512:
             _BUILT.clear()

@@ -378,8 +378,8 @@ def success_pivot(rows: Sequence[Mapping[str, Any]], key: str = "reached") -> li
     for name in planners:
         cells = []
         for k in moving:
-            r = by.get((k, name))
-            cells.append("-" if r is None else _rate_cell(r, key, short=True))
+            row = by.get((k, name))
+            cells.append("-" if row is None else _rate_cell(row, key, short=True))
         table.append([name] + cells)
     return table
 

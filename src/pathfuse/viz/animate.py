@@ -206,8 +206,8 @@ class _EpisodeRenderer:
         self.ax = ax
         draw_map(ax, grid)
         ax.tick_params(labelsize=7)
-        ax.xaxis.label.set_size(7)
-        ax.yaxis.label.set_size(7)
+        ax.xaxis.label.set_fontsize(7)
+        ax.yaxis.label.set_fontsize(7)
         ax.set_title(title if title is not None else f"{sc.name}: {ep.planner}", fontsize=9)
         ax.plot(*sc.start, "o", color="#2ca02c", ms=7, mec="k", zorder=6)
         ax.plot(*sc.goal, "*", color="#ffbf00", ms=12, mec="k", zorder=6)
@@ -475,8 +475,9 @@ def _write_gif(r: _EpisodeRenderer, ticks: np.ndarray, out: Path, fps: float,
                hold_s: float) -> tuple[int, int]:
     from PIL import Image
 
-    mediancut = getattr(getattr(Image, "Quantize", Image), "MEDIANCUT", 0)
-    no_dither = getattr(getattr(Image, "Dither", Image), "NONE", 0)
+    # Pillow < 9.1 has no Quantize/Dither enums: the plain ints then
+    mediancut: Any = getattr(getattr(Image, "Quantize", Image), "MEDIANCUT", 0)
+    no_dither: Any = getattr(getattr(Image, "Dither", Image), "NONE", 0)
 
     def rgb(k: int) -> Any:
         return Image.fromarray(np.ascontiguousarray(r.render(int(k))[:, :, :3]), "RGB")

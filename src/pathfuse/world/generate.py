@@ -96,6 +96,11 @@ def _random_free_point(rng: np.random.Generator, grid: GridMap, r: float) -> np.
     raise ConfigError(f"found no free spot for a disc of radius {r:g} m on map {grid.name!r}")
 
 
+def _xy(v: np.ndarray) -> tuple[float, float]:
+    """A 2-vector as a pair of Python floats."""
+    return float(v[0]), float(v[1])
+
+
 def _point_on(path: np.ndarray, s: float) -> tuple[np.ndarray, np.ndarray]:
     """Point at arc length ``s`` along ``path`` and the unit tangent there."""
     seg = np.hypot(*np.diff(path, axis=0).T)
@@ -119,23 +124,20 @@ def _draw_obstacle(rng: np.random.Generator, grid: GridMap, kind: str, speed: fl
         d = np.array([c * normal[0] - s * normal[1], s * normal[0] + c * normal[1]])
         p = q + rng.uniform(1.5, 4.0) * d
         if kind == "linear":
-            return LinearObstacle(tuple(map(float, p)), tuple(map(float, -d * speed)), radius)
+            return LinearObstacle(_xy(p), _xy(-d * speed), radius)
         if kind == "patrol":
             p2 = 2.0 * q - p
-            return PatrolObstacle((tuple(map(float, p)), tuple(map(float, p2))), speed, radius,
-                                  loop=False)
-        return RandomWalkObstacle(tuple(map(float, q)), speed, radius, seed=ob_seed,
+            return PatrolObstacle((_xy(p), _xy(p2)), speed, radius, loop=False)
+        return RandomWalkObstacle(_xy(q), speed, radius, seed=ob_seed,
                                   heading=float(math.atan2(-d[1], -d[0])))
     p = _random_free_point(rng, grid, radius)
     h = rng.uniform(-math.pi, math.pi)
     if kind == "linear":
-        return LinearObstacle(tuple(map(float, p)),
-                              (speed * math.cos(h), speed * math.sin(h)), radius)
+        return LinearObstacle(_xy(p), (speed * math.cos(h), speed * math.sin(h)), radius)
     if kind == "patrol":
         p2 = _random_free_point(rng, grid, radius)
-        return PatrolObstacle((tuple(map(float, p)), tuple(map(float, p2))), speed, radius,
-                              loop=False)
-    return RandomWalkObstacle(tuple(map(float, p)), speed, radius, seed=ob_seed, heading=h)
+        return PatrolObstacle((_xy(p), _xy(p2)), speed, radius, loop=False)
+    return RandomWalkObstacle(_xy(p), speed, radius, seed=ob_seed, heading=h)
 
 
 def _valid(grid: GridMap, ob: ObstacleSpec, start: np.ndarray, goal: np.ndarray,

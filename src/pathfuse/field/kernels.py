@@ -294,108 +294,6 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
     return nx, ny, True, math.hypot(tx - nx, ty - ny) <= 0.5 * step
 
 
-@njit(cache=True, inline="always")
-def _fusion_move(buf, kbuf, n, x, y, occ, pts, cum, state, f, i, dpos, dvel, drad):
-    """Mode 0: one move of Algorithm 2.  Returns ``(n, x, y, moved, stalled, blocked)``."""
-    k = advance_progress(x, y, pts, cum, state[S_K], f[F_R1], occ, f[F_OX], f[F_OY],
-                         f[F_RES], f[F_CLEAR])
-    state[S_K] = k
-    fx, fy, _ = fusion_force(x, y, f[F_GX], f[F_GY], pts, cum, k, i[I_AHEAD], f[F_KATT],
-                             f[F_KREP], f[F_RHO0], f[F_R1], f[F_R2], occ, f[F_OX], f[F_OY],
-                             f[F_RES])
-    dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
-    nx, ny, how = safe_step(x, y, fx + dfx, fy + dfy, f[F_STEP], occ, f[F_OX], f[F_OY],
-                            f[F_RES], f[F_CLEAR])
-    if how == HOW_BLOCKED:
-        return n, x, y, False, False, True
-    buf[n, 0] = nx
-    buf[n, 1] = ny
-    kbuf[n] = k
-    n += 1
-    stalled = False
-    stall_n = i[I_STALLN]
-    if n - 1 - state[S_REF] >= stall_n:
-        p = n - 1 - stall_n
-        ex = nx - buf[p, 0]
-        ey = ny - buf[p, 1]
-        stalled = ex * ex + ey * ey < f[F_STALLD] * f[F_STALLD]
-    return n, nx, ny, True, stalled, False
-
-
-@njit(cache=True, inline="always")
-def _escape_step(buf, kbuf, n, x, y, occ, pts, state, f, i, dpos, dvel, drad):
-    """Modes 1 and 2: one turn of an escape.  Returns ``(n, x, y, moved)``."""
-    m = pts.shape[0]
-    mode = state[S_MODE]
-    if mode == 2:
-        tx = buf[state[S_WB], 0]
-        ty = buf[state[S_WB], 1]
-    else:
-        tx = pts[state[S_T], 0]
-        ty = pts[state[S_T], 1]
-    moved = False
-    if x == tx and y == ty:
-        reached = True
-    else:
-        nx, ny, ok, reached = _escape_move(x, y, tx, ty, f[F_STEP], f, i, occ, f[F_OX],
-                                           f[F_OY], f[F_RES], f[F_CLEAR], dpos, dvel, drad)
-        state[S_ESTEPS] += 1
-        if not ok or (drad.shape[0] > 0 and state[S_ESTEPS] > 2 * i[I_STALLN]):
-            state[S_MODE] = 0  # blocked (or held up by discs): back to Algorithm 2
-            state[S_REF] = n - 1
-            return n, x, y, False
-        buf[n, 0] = nx
-        buf[n, 1] = ny
-        kbuf[n] = state[S_K]
-        n += 1
-        x = nx
-        y = ny
-        moved = True
-    if reached:
-        state[S_ESTEPS] = 0
-        if mode == 2:
-            if state[S_WB] <= state[S_WI]:
-                state[S_MODE] = 1
-            else:
-                state[S_WB] -= 1
-        else:
-            t = state[S_T]
-            if t > state[S_K]:
-                state[S_K] = t
-            if t >= state[S_ESC_K] or t >= m - 1:
-                state[S_MODE] = 0
-                state[S_REF] = n - 1
-            else:
-                state[S_T] = t + 1
-    return n, x, y, moved
-
-
-@njit(cache=True, inline="always")
-def _start_escape(buf, kbuf, n, occ, pts, cum, state, f, i):
-    """After a stall or a block: choose where to rejoin the path and enter the escape.
-
-    Returns ``(n, x, y, ok)``; ``ok`` is false when no walked point sees a path point.
-    """
-    ri, rj = find_rejoin(buf, n, pts, cum, f[F_R1] + f[F_RES], f[F_BACKOFF], occ, f[F_OX],
-                         f[F_OY], f[F_RES], f[F_CLEAR], kbuf, i[I_DRIVE] == 1)
-    if ri < 0:
-        return n, buf[n - 1, 0], buf[n - 1, 1], False
-    state[S_ESCAPES] += 1
-    state[S_BACKOFF] += n - 1 - ri
-    if i[I_DRIVE] == 1 and ri < n - 1:
-        state[S_MODE] = 2  # drive back along the trail to buf[ri]
-        state[S_WB] = n - 2
-        state[S_WI] = ri
-    else:
-        n = ri + 1  # planning: the walk after buf[ri] is dropped
-        state[S_MODE] = 1
-    state[S_ESTEPS] = 0
-    state[S_T] = rj
-    state[S_ESC_K] = min(max(state[S_K], rj) + i[I_ESC_PTS], pts.shape[0] - 1)
-    state[S_REF] = n - 1
-    return n, buf[n - 1, 0], buf[n - 1, 1], True
-
-
 @njit(cache=True)
 def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel, drad):
     """Algorithm 2 steps from ``buf[n-1]`` along the global path ``pts`` (M, 2).
@@ -422,12 +320,43 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
     turns ``4 M + 64`` times without moving ends as blocked (every loop
     ends).
     """
+    gx = f[F_GX]
+    gy = f[F_GY]
+    k_att = f[F_KATT]
+    k_rep = f[F_KREP]
+    rho0 = f[F_RHO0]
+    r1 = f[F_R1]
+    r2 = f[F_R2]
+    backoff_window = f[F_BACKOFF]
+    step = f[F_STEP]
+    tol = f[F_TOL]
+    clear = f[F_CLEAR]
+    stall_d = f[F_STALLD]
+    ox = f[F_OX]
+    oy = f[F_OY]
+    res = f[F_RES]
+    stall_n = i[I_STALLN]
+    ahead = i[I_AHEAD]
+    escape = i[I_ESCAPE]
+    esc_pts = i[I_ESC_PTS]
+    drive = i[I_DRIVE] == 1
+    m = pts.shape[0]
+    k = state[S_K]
+    mode = state[S_MODE]
+    ref = state[S_REF]
+    esc_k = state[S_ESC_K]
+    escapes = state[S_ESCAPES]
+    t = state[S_T]
+    backoff = state[S_BACKOFF]
+    wb = state[S_WB]
+    wi = state[S_WI]
+    esteps = state[S_ESTEPS]
     x = buf[n - 1, 0]
     y = buf[n - 1, 1]
     code = CODE_RUNNING
     steps = 0
     idle = 0  # loop turns since the last move: escapes that cannot move end as blocked
-    idle_cap = 4 * pts.shape[0] + 64
+    idle_cap = 4 * m + 64
     while True:
         idle += 1
         if idle > idle_cap:
@@ -436,8 +365,7 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
         if n + 2 > buf.shape[0]:
             buf = _grow(buf, n)
             kbuf = _grow_int(kbuf, n)
-        n, done = _goal_reached(buf, n, x, y, f[F_GX], f[F_GY], f[F_TOL], occ, f[F_OX],
-                                f[F_OY], f[F_RES], f[F_CLEAR])
+        n, done = _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear)
         if done != CODE_RUNNING:
             code = done
             break
@@ -445,23 +373,103 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
             break
         stalled = False
         blocked = False
-        if state[S_MODE] == 0:
-            n, x, y, moved, stalled, blocked = _fusion_move(buf, kbuf, n, x, y, occ, pts, cum,
-                                                            state, f, i, dpos, dvel, drad)
+        if mode == 0:
+            k = advance_progress(x, y, pts, cum, k, r1, occ, ox, oy, res, clear)
+            fx, fy, _ = fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0,
+                                     r1, r2, occ, ox, oy, res)
+            dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
+            nx, ny, how = safe_step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear)
+            if how == HOW_BLOCKED:
+                blocked = True
+            else:
+                buf[n, 0] = nx
+                buf[n, 1] = ny
+                kbuf[n] = k
+                n += 1
+                steps += 1
+                idle = 0
+                x = nx
+                y = ny
+                if n - 1 - ref >= stall_n:
+                    p = n - 1 - stall_n
+                    ex = x - buf[p, 0]
+                    ey = y - buf[p, 1]
+                    stalled = ex * ex + ey * ey < stall_d * stall_d
         else:
-            n, x, y, moved = _escape_step(buf, kbuf, n, x, y, occ, pts, state, f, i, dpos,
-                                          dvel, drad)
-        if moved:
-            steps += 1
-            idle = 0
+            # escape: towards the next walked point (mode 2) or path point (mode 1)
+            if mode == 2:
+                tx = buf[wb, 0]
+                ty = buf[wb, 1]
+            else:
+                tx = pts[t, 0]
+                ty = pts[t, 1]
+            if x == tx and y == ty:
+                reached = True
+            else:
+                nx, ny, moved, reached = _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy,
+                                                      res, clear, dpos, dvel, drad)
+                esteps += 1
+                if not moved or (drad.shape[0] > 0 and esteps > 2 * stall_n):
+                    mode = 0  # blocked (or held up by discs): back to Algorithm 2
+                    ref = n - 1
+                    continue
+                buf[n, 0] = nx
+                buf[n, 1] = ny
+                kbuf[n] = k
+                n += 1
+                steps += 1
+                idle = 0
+                x = nx
+                y = ny
+            if reached:
+                esteps = 0
+                if mode == 2:
+                    if wb <= wi:
+                        mode = 1
+                    else:
+                        wb -= 1
+                else:
+                    if t > k:
+                        k = t
+                    if t >= esc_k or t >= m - 1:
+                        mode = 0
+                        ref = n - 1
+                    else:
+                        t += 1
         if stalled or blocked:
-            if i[I_ESCAPE] != 1:
+            ri = -1
+            rj = -1
+            if escape == 1:
+                ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox, oy,
+                                     res, clear, kbuf, drive)
+            if ri < 0:
                 code = CODE_BLOCKED if blocked else CODE_STALLED
                 break
-            n, x, y, ok = _start_escape(buf, kbuf, n, occ, pts, cum, state, f, i)
-            if not ok:
-                code = CODE_BLOCKED if blocked else CODE_STALLED
-                break
+            escapes += 1
+            backoff += n - 1 - ri
+            if drive and ri < n - 1:
+                mode = 2
+                wb = n - 2
+                wi = ri
+            else:
+                n = ri + 1
+                x = buf[ri, 0]
+                y = buf[ri, 1]
+                mode = 1
+            esteps = 0
+            t = rj
+            esc_k = min(max(k, rj) + esc_pts, m - 1)
+            ref = n - 1
+    state[S_K] = k
+    state[S_MODE] = mode
+    state[S_REF] = ref
+    state[S_ESC_K] = esc_k
+    state[S_ESCAPES] = escapes
+    state[S_T] = t
+    state[S_BACKOFF] = backoff
+    state[S_WB] = wb
+    state[S_WI] = wi
+    state[S_ESTEPS] = esteps
     return buf, kbuf, n, code, steps
 
 

@@ -42,7 +42,6 @@ from pathfuse.grid import GridMap
 from pathfuse.problem import Problem
 from pathfuse.result import ConfigError, Status
 from pathfuse.search.astar import HEURISTICS, AStarSearcher, get_searcher
-from pathfuse.search.kernel import cell_centres
 
 __all__ = ["GlobalPlan", "plan_global", "route", "snap_cell"]
 
@@ -175,7 +174,9 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
     limit = budget.time_limit_s if time_limit_s is None else time_limit_s
     t0 = time.perf_counter()
     # the cells are in bounds and free (the problem and the snapping checked them)
-    res = searcher.search_checked(sc, gc, heuristic, max_expansions, limit)
+    ox, oy = grid.origin
+    res = searcher.search_checked(sc, gc, heuristic, max_expansions, limit,
+                                  (ox, oy, grid.resolution))
     elapsed = time.perf_counter() - t0
     if res.status is not Status.SUCCESS:
         if res.status is Status.NO_PATH:
@@ -189,10 +190,7 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
                    f"({res.expansions} expansions)")
         return GlobalPlan(res.status, expansions=res.expansions, time_s=elapsed, message=msg,
                           heuristic=heuristic, corner_cutting=corner_cutting)
-    cells = res.cells
-    ox, oy = grid.origin
-    points = cell_centres(cells, ox, oy, grid.resolution)
-    return GlobalPlan(Status.SUCCESS, cells, points, problem,
+    return GlobalPlan(Status.SUCCESS, res.cells, res.points, problem,
                       res.cost * grid.resolution, res.expansions, elapsed,
                       f"path through {len(res.cells)} cells, {res.cost * grid.resolution:.6g} m, "
                       f"{res.expansions} expansions", heuristic, corner_cutting)

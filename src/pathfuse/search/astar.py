@@ -69,7 +69,7 @@ import math
 import threading
 import time
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -98,6 +98,12 @@ SQRT2 = math.sqrt(2.0)
 HEURISTICS = ("euclidean", "octile")
 """Accepted heuristic names."""
 
+_NO_CELLS = np.zeros((0, 2), dtype=np.int64)
+_NO_CELLS.setflags(write=False)
+_NO_POINTS = np.zeros((0, 2))
+_NO_POINTS.setflags(write=False)
+
+
 # ----------------------------------------------------------------------------- Python API
 @dataclass
 class SearchResult:
@@ -114,16 +120,17 @@ class SearchResult:
         when there is no path.
     expansions : int
         Nodes closed by the search (0 when answered from connectivity labels).
+    points : ndarray, shape (N, 2), float
+        The cells' centres in world metres for the ``origin`` given to
+        :meth:`AStarSearcher.search_checked` (cell units with the origin at
+        ``(0, 0)`` otherwise).
     """
 
     status: Status
     cells: np.ndarray
     cost: float
     expansions: int
-
-
-_NO_CELLS = np.zeros((0, 2), dtype=np.int64)
-_NO_CELLS.setflags(write=False)
+    points: np.ndarray = field(default_factory=lambda: _NO_POINTS)
 
 
 class AStarSearcher:
@@ -231,21 +238,27 @@ class AStarSearcher:
             if not self._free[(r + 1) * self._wp + c + 1]:
                 raise QueryError(f"{what} cell ({r}, {c}) is occupied")
         with self.lock:
-            return self._search(sr, sc, gr, gc, heuristic, max_expansions, time_limit_s)
+            return self._search(sr, sc, gr, gc, heuristic, max_expansions, time_limit_s,
+                                (0.0, 0.0, 1.0))
 
     def search_checked(self, start_cell: tuple[int, int], goal_cell: tuple[int, int],
                        heuristic: str, max_expansions: int | None,
-                       time_limit_s: float | None) -> SearchResult:
+                       time_limit_s: float | None,
+                       origin: tuple[float, float, float] = (0.0, 0.0, 1.0)) -> SearchResult:
         """:meth:`search` for cells a :class:`~pathfuse.problem.Problem` has already checked
-        (in bounds and free; the heuristic a known name): the checks are not repeated."""
+        (in bounds and free; the heuristic a known name): the checks are not repeated.
+        ``origin`` is ``(x0, y0, resolution)`` of the map, for :attr:`SearchResult.points`."""
         with self.lock:
             return self._search(start_cell[0], start_cell[1], goal_cell[0], goal_cell[1],
-                                heuristic, max_expansions, time_limit_s)
+                                heuristic, max_expansions, time_limit_s, origin)
 
-    def _search(self, sr, sc, gr, gc, heuristic, max_expansions, time_limit_s) -> SearchResult:
+    def _search(self, sr, sc, gr, gc, heuristic, max_expansions, time_limit_s,
+                origin) -> SearchResult:
         t0 = time.perf_counter()
         if sr == gr and sc == gc:
-            return SearchResult(Status.SUCCESS, np.array([[sr, sc]], dtype=np.int64), 0.0, 0)
+            ox, oy, res = origin
+            return SearchResult(Status.SUCCESS, np.array([[sr, sc]], dtype=np.int64), 0.0, 0,
+                                np.array([[ox + (sc + 0.5) * res, oy + (sr + 0.5) * res]]))
         if self._labels[sr, sc] != self._labels[gr, gc]:
             return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, 0)
         budget = self.free_count if max_expansions is None else int(max_expansions)
@@ -271,8 +284,8 @@ class AStarSearcher:
             first = -1
             done += n
             if code == _FOUND:
-                cells = _trace(self._parent, start, goal, wp)
-                return SearchResult(Status.SUCCESS, cells, float(self._g[goal]), done)
+                cells, pts = _trace(self._parent, start, goal, wp, *origin)
+                return SearchResult(Status.SUCCESS, cells, float(self._g[goal]), done, pts)
             if code == _EXHAUSTED:
                 return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, done)
             if code == _HEAP_FULL:

@@ -342,8 +342,10 @@ def _astar_kernel(
 
 
 @njit(cache=True, nogil=True)
-def _trace(parent, start, goal, wp):
-    """(n, 2) int array of unpadded (row, col) cells from start to goal."""
+def _trace(parent, start, goal, wp, ox, oy, res):
+    """The path from start to goal: ``(cells, points)``, the (n, 2) unpadded ``(row, col)``
+    cells and their centres ``[x, y]`` for a grid of origin ``(ox, oy)`` and cell side
+    ``res`` (one call, so a query pays one dispatch for both)."""
     offs = np.array([1, -1, wp, -wp, wp + 1, wp - 1, -wp + 1, -wp - 1], dtype=np.int64)
     n = 1
     p = goal
@@ -351,24 +353,14 @@ def _trace(parent, start, goal, wp):
         p -= offs[parent[p]]
         n += 1
     out = np.empty((n, 2), dtype=np.int64)
+    pts = np.empty((n, 2))
     p = goal
     for i in range(n - 1, -1, -1):
         r = p // wp
         out[i, 0] = r - 1
         out[i, 1] = p - r * wp - 1
+        pts[i, 0] = ox + (out[i, 1] + 0.5) * res
+        pts[i, 1] = oy + (out[i, 0] + 0.5) * res
         if i > 0:
             p -= offs[parent[p]]
-    return out
-
-
-
-
-@njit(cache=True, nogil=True)
-def cell_centres(cells, ox, oy, res):
-    """World ``[x, y]`` of the centres of ``(row, col)`` cells (one call, any length)."""
-    n = cells.shape[0]
-    out = np.empty((n, 2))
-    for i in range(n):
-        out[i, 0] = ox + (cells[i, 1] + 0.5) * res
-        out[i, 1] = oy + (cells[i, 0] + 0.5) * res
-    return out
+    return out, pts

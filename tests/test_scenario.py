@@ -173,9 +173,9 @@ def test_file_errors_name_the_file_and_line():
         load_scenario(DATA / "bad_speed.yaml")
     assert str(info.value) == (f"{DATA / 'bad_speed.yaml'}: obstacles[1].speed: must be a "
                                f"number > 0, got 'fast'")
-    with pytest.raises(MapFormatError, match=r"bad_syntax.yaml, line 3, column 5"):
+    with pytest.raises(MapFormatError, match=r"bad_syntax.yaml: line 3, column 5"):
         load_scenario(DATA / "bad_syntax.yaml")
-    with pytest.raises(MapFormatError, match=r"duplicate_key.yaml, line 4.*duplicate key 'start'"):
+    with pytest.raises(MapFormatError, match=r"duplicate_key.yaml: line 4.*duplicate key 'start'"):
         load_scenario(DATA / "duplicate_key.yaml")
     with pytest.raises(ScenarioError, match=r"list.yaml: a scenario must be a mapping"):
         load_scenario(DATA / "list.yaml")

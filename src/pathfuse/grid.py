@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from pathfuse.result import MapError
+from pathfuse.validate import short as _shown
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -89,7 +90,7 @@ class GridMap:
         if occ.ndim != 2:
             raise MapError(f"occupancy must be a 2-D array, got shape {occ.shape}")
         if occ.size == 0:
-            raise MapError(f"map {self.name!r} is empty (shape {occ.shape})")
+            raise MapError(f"map {_shown(self.name)} is empty (shape {occ.shape})")
         if occ.dtype != np.bool_:
             if not np.issubdtype(occ.dtype, np.number):
                 raise MapError(f"occupancy must be boolean or numeric, got dtype {occ.dtype}")
@@ -100,16 +101,17 @@ class GridMap:
         try:
             res = float(self.resolution)
         except (TypeError, ValueError):
-            raise MapError(f"resolution must be a number, got {self.resolution!r}") from None
+            raise MapError(f"resolution must be a number, got {_shown(self.resolution)}") from None
         if not np.isfinite(res) or res <= 0:
-            raise MapError(f"resolution must be a finite number > 0, got {self.resolution!r}")
+            raise MapError(f"resolution must be a finite number > 0, got {_shown(self.resolution)}")
         object.__setattr__(self, "resolution", res)
         try:
             ox, oy = (float(v) for v in self.origin)
         except (TypeError, ValueError):
-            raise MapError(f"origin must be two numbers (x, y), got {self.origin!r}") from None
+            raise MapError(f"origin must be two numbers (x, y), got"
+                           f" {_shown(self.origin)}") from None
         if not (np.isfinite(ox) and np.isfinite(oy)):
-            raise MapError(f"origin must be finite, got {self.origin!r}")
+            raise MapError(f"origin must be finite, got {_shown(self.origin)}")
         object.__setattr__(self, "origin", (ox, oy))
 
     # ------------------------------------------------------------------ builders
@@ -227,7 +229,7 @@ class GridMap:
         """
         r = float(radius_m)
         if not np.isfinite(r) or r < 0:
-            raise MapError(f"inflation radius must be a finite number >= 0, got {radius_m!r}")
+            raise MapError(f"inflation radius must be a finite number >= 0, got {_shown(radius_m)}")
         cache = self._inflated
         if r not in cache:
             if len(cache) >= 8:
@@ -255,7 +257,7 @@ class GridMap:
         """
         r = float(radius_m)
         if not math.isfinite(r) or r < 0:
-            raise MapError(f"robot radius must be a finite number >= 0, got {radius_m!r}")
+            raise MapError(f"robot radius must be a finite number >= 0, got {_shown(radius_m)}")
         if r == 0:
             return self
         key = ("cspace", r)

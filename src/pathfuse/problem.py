@@ -29,6 +29,7 @@ from typing import Any
 
 from pathfuse.grid import GridMap
 from pathfuse.result import Budget, ConfigError, QueryError, Status
+from pathfuse.validate import short as _shown
 
 __all__ = ["Problem", "as_xy"]
 
@@ -46,7 +47,7 @@ def as_xy(value: object, what: str) -> tuple[float, float]:
     pathfuse.result.QueryError: goal: must be two numbers (x, y), got '12'
     """
     if isinstance(value, (str, bytes)):
-        raise QueryError(f"{what}: must be two numbers (x, y), got {value!r}")
+        raise QueryError(f"{what}: must be two numbers (x, y), got {_shown(value)}")
     x: Any
     y: Any
     try:
@@ -58,7 +59,7 @@ def as_xy(value: object, what: str) -> tuple[float, float]:
         shown = shown if len(shown) <= 60 else shown[:57] + "..."
         raise QueryError(f"{what}: must be two numbers (x, y), got {shown}") from None
     if not (math.isfinite(x) and math.isfinite(y)):
-        raise QueryError(f"{what}: must be finite, got {value!r}")
+        raise QueryError(f"{what}: must be finite, got {_shown(value)}")
     return x, y
 
 
@@ -123,7 +124,7 @@ class Problem:
                 ok = False
             if not ok:
                 raise ConfigError(
-                    f"robot_radius_m: must be a finite number >= 0, got {robot_radius_m!r}")
+                    f"robot_radius_m: must be a finite number >= 0, got {_shown(robot_radius_m)}")
         ox, oy = grid.origin
         res = grid.resolution
         return cls(grid, s, g, float(r), budget,

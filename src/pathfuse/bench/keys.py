@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.result import Budget, ConfigError
+from pathfuse.validate import short as _shown
 
 KEY_VERSION = 1
 """Bumped only if the meaning of a run key changes (it never silently does)."""
@@ -144,11 +145,11 @@ def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
             else:
                 seeds = tuple(int(t) for t in text.split(",") if t.strip())
         except ValueError:
-            raise bad(f"expected 'A:B', 'A,B,C' or a count, got {value!r}") from None
+            raise bad(f"expected 'A:B', 'A,B,C' or a count, got {_shown(value)}") from None
         if not seeds:
-            raise bad(f"{value!r} holds no seed")
+            raise bad(f"{_shown(value)} holds no seed")
         if min(seeds) < 0:
-            raise bad(f"seeds must be >= 0, got {value!r}")
+            raise bad(f"seeds must be >= 0, got {_shown(value)}")
         return seeds
     if isinstance(value, Mapping):
         unknown = set(value) - {"start", "count"}
@@ -156,20 +157,21 @@ def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
             raise bad(f"expected {{start: A, count: N}}, got {_short(dict(value))}")
         start, count = value.get("start", 0), value["count"]
         if not _is_int(start) or start < 0:
-            raise bad(f"start must be an integer >= 0, got {start!r}")
+            raise bad(f"start must be an integer >= 0, got {_shown(start)}")
         if not _is_int(count) or count < 1:
-            raise bad(f"count must be an integer >= 1, got {count!r}")
+            raise bad(f"count must be an integer >= 1, got {_shown(count)}")
         return tuple(range(int(start), int(start) + int(count)))
     if isinstance(value, (list, tuple)):
         if not value:
             raise bad("the seed list is empty")
         for i, s in enumerate(value):
             if not _is_int(s) or s < 0:
-                raise ConfigError(f"{where}[{i}]: a seed must be an integer >= 0, got {s!r}")
+                raise ConfigError(f"{where}[{i}]: a seed must be an integer >= 0, got {_shown(s)}")
         if len(set(value)) != len(value):
             raise bad("the seed list repeats a seed")
         return tuple(int(s) for s in value)
-    raise bad(f"expected a count, a list of integers, 'A:B' or {{start, count}}, got {value!r}")
+    raise bad(f"expected a count, a list of integers, 'A:B' or {{start, count}}, got"
+              f" {_shown(value)}")
 
 
 # --------------------------------------------------------------------------- entries
@@ -200,9 +202,9 @@ def _parse_limits(value: Any, where: str, base: Limits | None = None) -> Limits:
     t = value.get("time_limit_s", base.time_limit_s)
     m = value.get("max_iterations", base.max_iterations)
     if t is not None and (not _is_num(t) or float(t) <= 0):
-        raise ConfigError(f"{where}.time_limit_s: must be a number > 0, got {t!r}")
+        raise ConfigError(f"{where}.time_limit_s: must be a number > 0, got {_shown(t)}")
     if m is not None and (not _is_int(m) or m < 1):
-        raise ConfigError(f"{where}.max_iterations: must be an integer >= 1, got {m!r}")
+        raise ConfigError(f"{where}.max_iterations: must be an integer >= 1, got {_shown(m)}")
     return Limits(None if t is None else float(t), None if m is None else int(m))
 
 

@@ -29,6 +29,7 @@ from pathfuse.bench.keys import (
     run_key,
 )
 from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.validate import short as _shown
 
 
 @dataclass(frozen=True)
@@ -373,7 +374,7 @@ def _select_lines(probs: list[Any], sel: Any, where: str) -> list[Any]:
         out = []
         for i, ln in enumerate(sel):
             if not _is_int(ln) or ln not in by_line:
-                raise ConfigError(f"{where}[{i}]: no problem on line {ln!r} of the scen file "
+                raise ConfigError(f"{where}[{i}]: no problem on line {_shown(ln)} of the scen file "
                                   f"(lines {probs[0].line}..{probs[-1].line})" if probs else
                                   f"{where}[{i}]: the scen file holds no problem")
             out.append(by_line[int(ln)])
@@ -385,9 +386,9 @@ def _select_lines(probs: list[Any], sel: Any, where: str) -> list[Any]:
         if "sample" in keys and keys <= {"sample", "seed"}:
             n, s = sel["sample"], sel.get("seed", 0)
             if not _is_int(n) or n < 1:
-                raise ConfigError(f"{where}.sample: must be an integer >= 1, got {n!r}")
+                raise ConfigError(f"{where}.sample: must be an integer >= 1, got {_shown(n)}")
             if not _is_int(s) or s < 0:
-                raise ConfigError(f"{where}.seed: must be an integer >= 0, got {s!r}")
+                raise ConfigError(f"{where}.seed: must be an integer >= 0, got {_shown(s)}")
             if n >= len(probs):
                 return probs
             idx = np.sort(np.random.default_rng(int(s)).choice(len(probs), int(n),
@@ -396,7 +397,7 @@ def _select_lines(probs: list[Any], sel: Any, where: str) -> list[Any]:
         if keys == {"every"}:
             k = sel["every"]
             if not _is_int(k) or k < 1:
-                raise ConfigError(f"{where}.every: must be an integer >= 1, got {k!r}")
+                raise ConfigError(f"{where}.every: must be an integer >= 1, got {_shown(k)}")
             return probs[:: int(k)]
     raise ConfigError(f"{where}: expected N, a list of line numbers, {{limit: N}}, "
                       f"{{sample: N, seed: S}} or {{every: K}}, got {_short(sel)}")

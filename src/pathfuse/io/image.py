@@ -44,6 +44,7 @@ import numpy as np
 
 from pathfuse.grid import GridMap
 from pathfuse.result import MapError, MapFormatError
+from pathfuse.validate import short as _shown
 
 __all__ = ["read_image", "read_npy", "load_pixels", "IMAGE_SUFFIXES"]
 
@@ -123,7 +124,7 @@ def load_pixels(
         grey = arr / 65535.0 * 255.0
     else:
         raise MapFormatError(
-            f"{context}{path}: unsupported image mode {mode!r} "
+            f"{context}{path}: unsupported image mode {_shown(mode)} "
             "(use grey, grey+alpha, palette, RGB or RGBA)"
         )
     if grey.ndim != 2 or grey.size == 0:
@@ -135,13 +136,13 @@ def _resolution(value: object, path: Path) -> float:
     if value is None:
         raise MapError(f"{path}: a resolution (metres per cell) is required for this map file")
     if isinstance(value, bool):
-        raise MapError(f"{path}: resolution must be a number, got {value!r}")
+        raise MapError(f"{path}: resolution must be a number, got {_shown(value)}")
     try:
         res = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
-        raise MapError(f"{path}: resolution must be a number, got {value!r}") from None
+        raise MapError(f"{path}: resolution must be a number, got {_shown(value)}") from None
     if not math.isfinite(res) or res <= 0:
-        raise MapError(f"{path}: resolution must be a finite number > 0, got {value!r}")
+        raise MapError(f"{path}: resolution must be a finite number > 0, got {_shown(value)}")
     return res
 
 
@@ -150,9 +151,9 @@ def _origin(value: object, path: Path) -> tuple[float, float]:
         # any iterable of two numbers; a TypeError is reported below
         ox, oy = (float(v) for v in value)  # type: ignore[attr-defined]
     except (TypeError, ValueError):
-        raise MapError(f"{path}: origin must be two numbers (x, y), got {value!r}") from None
+        raise MapError(f"{path}: origin must be two numbers (x, y), got {_shown(value)}") from None
     if not (math.isfinite(ox) and math.isfinite(oy)):
-        raise MapError(f"{path}: origin must be finite, got {value!r}")
+        raise MapError(f"{path}: origin must be finite, got {_shown(value)}")
     return ox, oy
 
 
@@ -202,10 +203,10 @@ def read_image(
     try:
         thr = float(threshold)
     except (TypeError, ValueError):
-        raise MapError(f"{path}: threshold must be a number in [0, 1], got {threshold!r}") \
+        raise MapError(f"{path}: threshold must be a number in [0, 1], got {_shown(threshold)}") \
             from None
     if not (0.0 <= thr <= 1.0):
-        raise MapError(f"{path}: threshold must be in [0, 1], got {threshold!r}")
+        raise MapError(f"{path}: threshold must be in [0, 1], got {_shown(threshold)}")
     grey, _alpha = load_pixels(path)
     shade = grey / 255.0
     occ = shade if negate else 1.0 - shade

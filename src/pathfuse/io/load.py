@@ -39,6 +39,7 @@ from pathfuse.io.inline import read_rows_yaml
 from pathfuse.io.movingai import read_movingai
 from pathfuse.io.ros import UNKNOWN_POLICIES, _read_ros_doc, load_yaml_mapping
 from pathfuse.result import ConfigError, MapError, MapFormatError
+from pathfuse.validate import short as _shown
 
 __all__ = ["load_map", "map_from_spec", "SUPPORTED_SUFFIXES", "SPEC_SOURCES"]
 
@@ -63,7 +64,7 @@ _RANDOM_KEYS = ("size", "resolution", "obstacles", "density", "seed", "origin",
 
 def _check_unknown(unknown: str) -> None:
     if unknown not in UNKNOWN_POLICIES:
-        raise ConfigError(f"unknown must be 'occupied' or 'free', got {unknown!r}")
+        raise ConfigError(f"unknown must be 'occupied' or 'free', got {_shown(unknown)}")
 
 
 def load_map(
@@ -112,12 +113,12 @@ def load_map(
             raise ConfigError("the paper map has a fixed resolution (1 m) and origin (-0.5, -0.5)")
         return paper_map(0 if seed is None else seed)
     if not isinstance(spec, (str, os.PathLike)):
-        raise ConfigError(f"a map is 'paper' or a file path, got {spec!r}")
+        raise ConfigError(f"a map is 'paper' or a file path, got {_shown(spec)}")
     path = Path(os.path.expanduser(os.fspath(spec)))
     suffix = path.suffix.lower()
     if suffix not in SUPPORTED_SUFFIXES:
         raise MapFormatError(
-            f"{path}: unsupported map file type {suffix or '(no extension)'!r}; "
+            f"{path}: unsupported map file type {_shown(suffix or '(no extension)')}; "
             f"supported: 'paper', {', '.join(SUPPORTED_SUFFIXES)}"
         )
     if not path.exists():
@@ -136,7 +137,7 @@ def load_map(
             for key, val in (("resolution", resolution), ("origin", origin)):
                 if val is not None:
                     raise ConfigError(
-                        f"{path}: a ROS map sets its own {key}; do not pass {key}={val!r}"
+                        f"{path}: a ROS map sets its own {key}; do not pass {key}={_shown(val)}"
                     )
             return _read_ros_doc(path, doc, unknown, None)
         if "rows" in doc:
@@ -152,7 +153,7 @@ def load_map(
 
 def _resolve(base_dir: Path, value: object, key: str) -> Path:
     if not isinstance(value, (str, os.PathLike)) or not os.fspath(value).strip():
-        raise ConfigError(f"map spec key '{key}' must be a file path, got {value!r}")
+        raise ConfigError(f"map spec key '{key}' must be a file path, got {_shown(value)}")
     p = Path(os.path.expanduser(os.fspath(value)))
     return p if p.is_absolute() else base_dir / p
 
@@ -161,7 +162,7 @@ def _random_from_spec(value: object, name: str | None) -> GridMap:
     if not isinstance(value, Mapping):
         raise ConfigError(
             f"map spec key 'random' must be a mapping (size, resolution, obstacles | density, "
-            f"seed, ...), got {value!r}"
+            f"seed, ...), got {_shown(value)}"
         )
     for key in value:
         if key not in _RANDOM_KEYS:
@@ -227,7 +228,7 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
             return paper_map(0)
         return load_map(_resolve(base, s, "map"))
     if not isinstance(spec, Mapping):
-        raise ConfigError(f"a map spec must be a mapping or a file name, got {spec!r}")
+        raise ConfigError(f"a map spec must be a mapping or a file name, got {_shown(spec)}")
     sources = [k for k in SPEC_SOURCES if k in spec]
     if len(sources) != 1:
         what = "no" if not sources else f"several ({', '.join(sources)})"
@@ -239,13 +240,13 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
     for key in spec:
         if key != src and key not in allowed:
             raise ConfigError(
-                f"unknown key {key!r} in a '{src}' map spec (allowed with '{src}': "
+                f"unknown key {_shown(key)} in a '{src}' map spec (allowed with '{src}': "
                 f"{', '.join(allowed) if allowed else 'nothing else'})"
             )
     value = spec[src]
     name = spec.get("name")
     if name is not None and not isinstance(name, str):
-        raise ConfigError(f"map spec key 'name' must be a string, got {name!r}")
+        raise ConfigError(f"map spec key 'name' must be a string, got {_shown(name)}")
 
     if src == "random":
         return _random_from_spec(value, name)
@@ -260,7 +261,8 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
         else:
             seed = value
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            raise ConfigError(f"map spec 'paper' seed must be a non-negative integer, got {seed!r}")
+            raise ConfigError(f"map spec 'paper' seed must be a non-negative integer, got"
+                              f" {_shown(seed)}")
         return paper_map(seed)
     if src == "rows":
         doc = {"rows": value}
@@ -284,6 +286,6 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
         return read_npy(path, spec["resolution"], spec.get("origin", (0.0, 0.0)), name=name)
     negate = spec.get("negate", False)
     if not isinstance(negate, bool):
-        raise ConfigError(f"map spec key 'negate' must be true or false, got {negate!r}")
+        raise ConfigError(f"map spec key 'negate' must be true or false, got {_shown(negate)}")
     return read_image(path, spec["resolution"], spec.get("origin", (0.0, 0.0)),
                       threshold=spec.get("threshold", 0.5), negate=negate, name=name)

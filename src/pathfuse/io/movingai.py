@@ -46,6 +46,7 @@ import numpy as np
 
 from pathfuse.grid import GridMap
 from pathfuse.result import MapError, MapFormatError
+from pathfuse.validate import short as _shown
 
 __all__ = [
     "read_movingai",
@@ -107,14 +108,14 @@ def _header_int(path: Path, lineno: int, key: str, text: bytes) -> int:
     if len(parts) != 2 or parts[0].decode("ascii", "replace").lower() != key:
         raise MapFormatError(
             f"{path}, line {lineno}: expected '{key} <integer>', "
-            f"got {text.decode('ascii', 'replace')!r}"
+            f"got {_shown(text.decode('ascii', 'replace'))}"
         )
     raw = parts[1].decode("ascii", "replace")
     try:
         value = int(raw)
     except ValueError:
         raise MapFormatError(
-            f"{path}, line {lineno}: {key} must be an integer, got {raw!r}"
+            f"{path}, line {lineno}: {key} must be an integer, got {_shown(raw)}"
         ) from None
     if value <= 0:
         raise MapFormatError(f"{path}, line {lineno}: {key} must be > 0, got {value}")
@@ -164,12 +165,12 @@ def read_movingai(
     if len(first) != 2 or first[0].lower() != b"type":
         raise MapFormatError(
             f"{path}, line {i + 1}: expected header 'type octile', "
-            f"got {lines[i].decode('ascii', 'replace')!r}"
+            f"got {_shown(lines[i].decode('ascii', 'replace'))}"
         )
     if first[1].lower() != b"octile":
         raise MapFormatError(
             f"{path}, line {i + 1}: unsupported map type "
-            f"{first[1].decode('ascii', 'replace')!r} (only 'octile' is supported)"
+            f"{_shown(first[1].decode('ascii', 'replace'))} (only 'octile' is supported)"
         )
     sizes: dict[str, int] = {}
     for _ in range(2):
@@ -184,7 +185,7 @@ def read_movingai(
             want = " or ".join(k for k in ("height", "width") if k not in sizes)
             raise MapFormatError(
                 f"{path}, line {i + 1}: expected '{want} <integer>', "
-                f"got {lines[i].decode('ascii', 'replace')!r}"
+                f"got {_shown(lines[i].decode('ascii', 'replace'))}"
             )
         sizes[key_s] = _header_int(path, i + 1, key_s, lines[i])
     i += 1
@@ -192,7 +193,7 @@ def read_movingai(
         raise MapFormatError(f"{path}, line {i + 1}: file ends inside the header (expected 'map')")
     if lines[i].strip().lower() != b"map":
         got = lines[i].decode("ascii", "replace")
-        raise MapFormatError(f"{path}, line {i + 1}: expected 'map', got {got!r}")
+        raise MapFormatError(f"{path}, line {i + 1}: expected 'map', got {_shown(got)}")
     height, width = sizes["height"], sizes["width"]
     first_row = i + 1
     rows = lines[first_row:first_row + height]
@@ -208,7 +209,7 @@ def read_movingai(
         if extra.strip():
             raise MapFormatError(
                 f"{path}, line {first_row + height + k + 1}: unexpected content after the "
-                f"{height} map rows: {extra[:40].decode('ascii', 'replace')!r}"
+                f"{height} map rows: {_shown(extra[:40].decode('ascii', 'replace'))}"
             )
     grid = np.empty((height, width), dtype=np.bool_)
     for r, row in enumerate(rows):
@@ -224,8 +225,8 @@ def read_movingai(
             col = int(bad[0])
             ch = row[col:col + 1].decode("latin-1")
             raise MapFormatError(
-                f"{path}, line {lineno}, column {col + 1}: unknown map character {ch!r} "
-                f"(free: {FREE_CHARS!r}, blocked: {BLOCKED_CHARS!r})"
+                f"{path}, line {lineno}, column {col + 1}: unknown map character {_shown(ch)} "
+                f"(free: {_shown(FREE_CHARS)}, blocked: {_shown(BLOCKED_CHARS)})"
             )
         grid[r] = codes == 1
     try:

@@ -66,6 +66,7 @@ import yaml
 from pathfuse import validate
 from pathfuse.grid import GridMap
 from pathfuse.result import ConfigError, MapFormatError, PathfuseError
+from pathfuse.validate import short as _shown
 from pathfuse.world.geometry import segment_static_distance
 from pathfuse.world.obstacles import (
     LinearObstacle,
@@ -366,7 +367,7 @@ def _parse_obstacle(v: Any, index: int) -> ObstacleSpec:
     if not isinstance(v, Mapping):
         raise ScenarioError(
             f"{key}: must be a mapping with position+velocity, waypoints+speed or random_walk, "
-            f"got {v!r}"
+            f"got {_shown(v)}"
         )
     if "random_walk" in v:
         m = _mapping(v, key, _RW_OUTER_KEYS)
@@ -389,7 +390,7 @@ def _parse_obstacle(v: Any, index: int) -> ObstacleSpec:
         wps = m["waypoints"]
         if not isinstance(wps, (list, tuple)) or len(wps) < 2:
             raise ScenarioError(f"{key}.waypoints: must be a list of at least two [x, y] points, "
-                                f"got {wps!r}")
+                                f"got {_shown(wps)}")
         if "speed" not in m:
             raise ScenarioError(f"{key}.speed: missing (m/s along the waypoints)")
         pts = tuple(_point(p, f"{key}.waypoints[{j}]") for j, p in enumerate(wps))
@@ -432,7 +433,8 @@ def _parse_planner(v: Any) -> PlannerChoice:
     except ConfigError as exc:
         raise ScenarioError(f"planner.name: {exc}") from None
     if not spec.online:
-        raise ScenarioError(f"planner.name: {name!r} only plans offline (it cannot be simulated)")
+        raise ScenarioError(f"planner.name:"
+                            f" {_shown(name)} only plans offline (it cannot be simulated)")
     make_params(spec, params, key="planner.params", error=ScenarioError)
     return PlannerChoice(name=spec.name, params=dict(params))
 
@@ -455,7 +457,7 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
     ``doc["map"]`` may also be a :class:`~pathfuse.grid.GridMap` instance.
     """
     if not isinstance(doc, Mapping):
-        raise ScenarioError(f"a scenario must be a mapping of keys to values, got {doc!r}")
+        raise ScenarioError(f"a scenario must be a mapping of keys to values, got {_shown(doc)}")
     _mapping(doc, "", SCENARIO_KEYS)
     for k in _REQUIRED:
         if k not in doc:
@@ -468,7 +470,8 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
         from pathfuse.io import map_from_spec
 
         if not isinstance(mspec, (Mapping, str)):
-            raise ScenarioError(f"map: must be a map spec mapping or a file name, got {mspec!r}")
+            raise ScenarioError(f"map: must be a map spec mapping or a file name, got"
+                                f" {_shown(mspec)}")
         try:
             grid = map_from_spec(mspec, base_dir)
         except PathfuseError as exc:
@@ -479,7 +482,7 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
             raise err from None
     obstacles = doc.get("obstacles") or []
     if not isinstance(obstacles, (list, tuple)):
-        raise ScenarioError(f"obstacles: must be a list of obstacles, got {obstacles!r}")
+        raise ScenarioError(f"obstacles: must be a list of obstacles, got {_shown(obstacles)}")
     seed = doc.get("seed")
     name = doc.get("name", default_name)
     return Scenario(
@@ -503,45 +506,10 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
 
 
 # ---------------------------------------------------------------------- files
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """A SafeLoader that refuses a repeated key instead of keeping the last one."""
-
-
-def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode,
-                       deep: bool = False) -> dict:
-    loader.flatten_mapping(node)
-    seen: dict[Any, Any] = {}
-    for knode, vnode in node.value:
-        k = loader.construct_object(knode, deep=deep)
-        if k in seen:
-            raise yaml.constructor.ConstructorError(
-                None, None, f"duplicate key {k!r}", knode.start_mark)
-        seen[k] = loader.construct_object(vnode, deep=deep)
-    return seen
-
-
-_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
-                                 _construct_mapping)
-
-
 def _read_yaml(path: Path) -> Any:
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise MapFormatError(f"scenario file not found: {path}") from None
-    except IsADirectoryError:
-        raise MapFormatError(f"scenario path is a directory, not a file: {path}") from None
-    except UnicodeDecodeError as exc:
-        raise MapFormatError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
-    except OSError as exc:
-        raise MapFormatError(f"{path}: cannot read the scenario ({exc.strerror})") from None
-    try:
-        return yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 - a SafeLoader subclass
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f", line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or str(exc)
-        raise MapFormatError(f"{path}{where}: YAML error: {problem}") from None
+    from pathfuse.safeyaml import read_yaml
+
+    return read_yaml(path, "scenario", MapFormatError)
 
 
 def load_scenario(scenario: str | os.PathLike[str] | Mapping[str, Any] | Scenario,

@@ -40,6 +40,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from pathfuse.grid import GridMap
+from pathfuse.limits import check_cells
 from pathfuse.result import ConfigError, MapError
 from pathfuse.validate import short as _shown
 
@@ -72,6 +73,9 @@ _DEFAULT_MAX_ATTEMPTS = 1000
 
 def _cells_of(size: float, resolution: float, axis: str) -> int:
     n = size / resolution
+    if not math.isfinite(n):
+        raise MapError(f"map {axis} size {size:g} m at {resolution:g} m cells is not a finite "
+                       "number of cells")
     k = int(round(n))
     if k < 1 or abs(n - k) > 1e-6 * max(1.0, n):
         raise MapError(
@@ -194,6 +198,8 @@ def random_map(
     except (TypeError, ValueError):
         raise MapError(f"origin must be two numbers (x, y), got {_shown(origin)}") from None
     n_cells = width * height
+    check_cells(height, width, f"random map {float(sizes[0]):g} m x {float(sizes[1]):g} m "
+                f"at {res:g} m")
 
     if obstacles is not None:
         if isinstance(obstacles, bool) or not isinstance(obstacles, (int, np.integer)) \

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
+from pathfuse.limits import MAX_EXTENT_M
 from pathfuse.result import MapError
 from pathfuse.validate import short as _shown
 
@@ -38,6 +39,9 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
 __all__ = ["GridMap"]
+
+_KERNEL_MAX = 24
+"""Inflation kernels wider than this many cells each side use the distance transform."""
 
 
 def _as_points(xy: object, what: str = "point") -> np.ndarray:
@@ -112,6 +116,13 @@ class GridMap:
                            f" {_shown(self.origin)}") from None
         if not (np.isfinite(ox) and np.isfinite(oy)):
             raise MapError(f"origin must be finite, got {_shown(self.origin)}")
+        h, w = occ.shape
+        far = max(abs(ox), abs(oy), abs(ox + w * res), abs(oy + h * res))
+        if not far <= MAX_EXTENT_M:
+            raise MapError(
+                f"the map reaches {far:.3g} m from the world origin (resolution {res:g} m, "
+                f"origin ({ox:g}, {oy:g}), {h} x {w} cells); pathfuse works within "
+                f"{MAX_EXTENT_M:g} m (MAX_EXTENT_M)")
         object.__setattr__(self, "origin", (ox, oy))
 
     # ------------------------------------------------------------------ builders
@@ -265,6 +276,12 @@ class GridMap:
         if key not in cache:
             if len(cache) >= 8:
                 cache.pop(next(iter(cache)))
+            if r > min(self.shape) * self.resolution / 2:
+                # every cell centre is closer than r to the map's edge: nothing is free (and
+                # no padding as wide as the radius is allocated)
+                cache[key] = self.with_occupied(np.ones_like(self.occupied),
+                                                name=f"{self.name}+r{r:g}")
+                return cache[key]  # type: ignore[return-value]
             k = int(math.ceil(r / self.resolution + 0.5)) + 1
             padded = np.pad(self.occupied, k, constant_values=True)
             res = self.resolution
@@ -276,17 +293,46 @@ class GridMap:
     def _inflate(self, r: float) -> GridMap:
         if r == 0 or not self.occupied.any():
             return self.with_occupied(self.occupied.copy())
+        h, w = self.shape
+        if r > math.hypot(h, w) * self.resolution:
+            # farther than the map's diagonal: every cell is within r of every obstacle
+            return self.with_occupied(np.ones_like(self.occupied), name=f"{self.name}+r{r:g}")
         # distance from a cell centre to the nearest point of an occupied square
         # = distance to the square's centre shrunk by half a cell on each axis.
         k = int(np.ceil(r / self.resolution + 0.5))
-        d = np.arange(-k, k + 1, dtype=np.float64)
-        dx = np.maximum(np.abs(d)[None, :] - 0.5, 0.0)
-        dy = np.maximum(np.abs(d)[:, None] - 0.5, 0.0)
-        footprint = np.hypot(dx, dy) * self.resolution < r
+        if k > _KERNEL_MAX:
+            grown = self._inflate_far(r)
+        else:
+            d = np.arange(-k, k + 1, dtype=np.float64)
+            dx = np.maximum(np.abs(d)[None, :] - 0.5, 0.0)
+            dy = np.maximum(np.abs(d)[:, None] - 0.5, 0.0)
+            footprint = np.hypot(dx, dy) * self.resolution < r
+            from scipy import ndimage
+
+            grown = ndimage.binary_dilation(self.occupied, structure=footprint)
+        return self.with_occupied(grown | self.occupied, name=f"{self.name}+r{r:g}")
+
+    def _inflate_far(self, r: float) -> np.ndarray:
+        """Inflation by a radius wider than the dilation kernel allows, in time and memory
+        linear in the map (not in the radius): the nearest point of a square to a cell
+        centre is one of its corners or edge midpoints, all on the half-cell lattice, so
+        one exact distance transform of that lattice finds it."""
         from scipy import ndimage
 
-        grown = ndimage.binary_dilation(self.occupied, structure=footprint)
-        return self.with_occupied(grown | self.occupied, name=f"{self.name}+r{r:g}")
+        h, w = self.shape
+        lat = np.zeros((2 * h + 1, 2 * w + 1), dtype=bool)
+        rr, cc = np.nonzero(self.occupied)
+        for di in (0, 1, 2):
+            for dj in (0, 1, 2):
+                if di != 1 or dj != 1:
+                    lat[2 * rr + di, 2 * cc + dj] = True
+        idx = ndimage.distance_transform_edt(~lat, return_distances=False, return_indices=True)
+        ci = np.arange(1, 2 * h, 2)[:, None]
+        cj = np.arange(1, 2 * w, 2)[None, :]
+        # the same formula as the kernel's: half-cell offsets, hypot, times the resolution
+        dy = np.abs(idx[0][1::2, 1::2] - ci) * 0.5
+        dx = np.abs(idx[1][1::2, 1::2] - cj) * 0.5
+        return np.hypot(dx, dy) * self.resolution < r
 
     @cached_property
     def distance_field(self) -> np.ndarray:

@@ -23,8 +23,9 @@ limit                      default          what it bounds
 ``MAX_YAML_DEPTH``         100              nesting depth of YAML collections
 =========================  ===============  =====================================================
 
-Seeds are also bounded by the store: a seed is an integer in ``[0, 2**63)``
-(:data:`MAX_SEED`), SQLite's integer range.
+Two fixed bounds: a seed is an integer in ``[0, 2**63)`` (:data:`MAX_SEED`,
+SQLite's integer range), and a map lies within ``1e12`` m of the world origin
+(:data:`MAX_EXTENT_M`).
 
 Examples
 --------
@@ -49,6 +50,7 @@ __all__ = [
     "LimitError",
     "DEFAULTS",
     "MAX_SEED",
+    "MAX_EXTENT_M",
     "limit",
     "env_name",
     "check_count",
@@ -66,6 +68,10 @@ DEFAULTS: dict[str, int] = {
     "MAX_YAML_DEPTH": 100,
 }
 """Default value of every limit (see the module docstring)."""
+
+MAX_EXTENT_M = 1e12
+"""Every map lies within this many metres of the world origin (so that squared distances
+stay finite): a ROS ``resolution: 1e308`` is refused, not planned on."""
 
 MAX_SEED = 2**63 - 1
 """The largest seed: seeds are stored as SQLite (signed 64-bit) integers."""

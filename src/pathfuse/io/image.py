@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from pathfuse.grid import GridMap
+from pathfuse.limits import check_cells
 from pathfuse.result import MapError, MapFormatError
 from pathfuse.validate import short as _shown
 
@@ -84,6 +85,8 @@ def load_pixels(
     img: Image.Image  # an ImageFile until converted below
     try:
         with Image.open(path) as im:
+            w, h = im.size  # from the header: check before decoding
+            check_cells(h, w, f"{context}{path}: image", MapFormatError)
             im.load()
             img = im
     except UnidentifiedImageError:
@@ -258,10 +261,15 @@ def read_npy(
     org = _origin(origin, path)
     _check_file(path, "array file")
     try:
-        arr = np.load(path, allow_pickle=False)
+        # the header first (a memory map reads no data), so a huge array is refused unread
+        head = np.load(path, allow_pickle=False, mmap_mode="r")
+        if isinstance(head, np.ndarray) and head.ndim == 2:
+            check_cells(head.shape[0], head.shape[1], f"{path}: array", MapFormatError)
+        arr = np.array(head) if isinstance(head, np.memmap) else head
+        del head
     except ValueError as exc:
         msg = str(exc)
-        if "allow_pickle" in msg or "pickle" in msg.lower():
+        if "allow_pickle" in msg or "pickle" in msg.lower() or "Python objects" in msg:
             raise MapFormatError(
                 f"{path}: holds an object (pickled) array; save a bool or numeric array"
             ) from None

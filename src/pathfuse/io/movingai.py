@@ -45,6 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from pathfuse.grid import GridMap
+from pathfuse.limits import check_cells, read_capped
 from pathfuse.result import MapError, MapFormatError
 from pathfuse.validate import short as _shown
 
@@ -90,7 +91,7 @@ def cell_to_movingai(row: int, col: int, height: int) -> tuple[int, int]:
 
 def _read_lines(path: Path) -> list[bytes]:
     try:
-        data = path.read_bytes()
+        data = read_capped(path, "the map file")
     except FileNotFoundError:
         raise MapFormatError(f"{path}: no such map file") from None
     except IsADirectoryError:
@@ -163,9 +164,12 @@ def read_movingai(
         i += 1
     first = lines[i].split() if i < len(lines) else []
     if len(first) != 2 or first[0].lower() != b"type":
+        hint = ""
+        if first[:1] == [b"version"] or path.suffix.lower() == ".scen":
+            hint = " (this is a MovingAI scenario file (.scen), not a map: give the .map first)"
         raise MapFormatError(
             f"{path}, line {i + 1}: expected header 'type octile', "
-            f"got {_shown(lines[i].decode('ascii', 'replace'))}"
+            f"got {_shown(lines[i].decode('ascii', 'replace'))}{hint}"
         )
     if first[1].lower() != b"octile":
         raise MapFormatError(
@@ -195,6 +199,7 @@ def read_movingai(
         got = lines[i].decode("ascii", "replace")
         raise MapFormatError(f"{path}, line {i + 1}: expected 'map', got {_shown(got)}")
     height, width = sizes["height"], sizes["width"]
+    check_cells(height, width, f"{path}: header", MapFormatError)
     first_row = i + 1
     rows = lines[first_row:first_row + height]
     # a final newline leaves one empty string at the end: ignore trailing blank lines
@@ -254,4 +259,8 @@ def write_movingai(grid: GridMap, path: str | os.PathLike[str]) -> None:
     chars = np.where(occ[::-1], ord("@"), ord(".")).astype(np.uint8)
     body = b"\n".join(bytes(row) for row in chars)
     text = f"type octile\nheight {h}\nwidth {w}\nmap\n".encode("ascii") + body + b"\n"
-    Path(path).write_bytes(text)
+    try:
+        Path(path).write_bytes(text)
+    except OSError as exc:
+        raise MapFormatError(f"{path}: cannot write the map file ({exc.strerror or exc})") \
+            from None

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse.limits import MAX_SEED, check_count
 from pathfuse.result import Budget, ConfigError
 from pathfuse.validate import short as _shown
 
@@ -132,24 +133,37 @@ def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
     def bad(msg: str) -> ConfigError:
         return ConfigError(f"{where}: {msg}")
 
+    def counted(start: int, count: int) -> tuple[int, ...]:
+        if start < 0 or start > MAX_SEED:
+            raise bad(f"seeds must be integers in [0, 2**63), got {_shown(start)}")
+        check_count(count, "MAX_RUNS", f"{where}: a seed count")
+        if start + count - 1 > MAX_SEED:
+            raise bad(f"seeds must be integers in [0, 2**63), got up to {start + count - 1}")
+        return tuple(range(start, start + count))
+
     if _is_int(value):
         if value < 1:
             raise bad(f"a seed count must be >= 1, got {value}")
-        return tuple(range(int(value)))
+        return counted(0, int(value))
     if isinstance(value, str):
         text = value.strip()
+        if len(text) > 100_000:
+            raise bad(f"a seed text of {len(text)} characters is too long; use 'A:B' or a count")
         try:
             if ":" in text:
                 a, b = (int(t) for t in text.split(":"))
-                seeds = tuple(range(a, b))
             else:
                 seeds = tuple(int(t) for t in text.split(",") if t.strip())
         except ValueError:
             raise bad(f"expected 'A:B', 'A,B,C' or a count, got {_shown(value)}") from None
+        if ":" in text:
+            if b <= a:
+                raise bad(f"{_shown(value)} holds no seed")
+            return counted(a, b - a)
         if not seeds:
             raise bad(f"{_shown(value)} holds no seed")
-        if min(seeds) < 0:
-            raise bad(f"seeds must be >= 0, got {_shown(value)}")
+        if min(seeds) < 0 or max(seeds) > MAX_SEED:
+            raise bad(f"seeds must be integers in [0, 2**63), got {_shown(value)}")
         return seeds
     if isinstance(value, Mapping):
         unknown = set(value) - {"start", "count"}
@@ -160,18 +174,20 @@ def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
             raise bad(f"start must be an integer >= 0, got {_shown(start)}")
         if not _is_int(count) or count < 1:
             raise bad(f"count must be an integer >= 1, got {_shown(count)}")
-        return tuple(range(int(start), int(start) + int(count)))
+        return counted(int(start), int(count))
     if isinstance(value, (list, tuple)):
         if not value:
             raise bad("the seed list is empty")
+        check_count(len(value), "MAX_RUNS", f"{where}: a seed list")
         for i, s in enumerate(value):
-            if not _is_int(s) or s < 0:
-                raise ConfigError(f"{where}[{i}]: a seed must be an integer >= 0, got {_shown(s)}")
+            if not _is_int(s) or s < 0 or s > MAX_SEED:
+                raise ConfigError(f"{where}[{i}]: a seed must be an integer in [0, 2**63), "
+                                  f"got {_shown(s)}")
         if len(set(value)) != len(value):
             raise bad("the seed list repeats a seed")
         return tuple(int(s) for s in value)
-    raise bad(f"expected a count, a list of integers, 'A:B' or {{start, count}}, got"
-              f" {_shown(value)}")
+    raise bad(f"expected a count, a list of integers, 'A:B' or {{start, count}}, "
+              f"got {_shown(value)}")
 
 
 # --------------------------------------------------------------------------- entries

@@ -41,6 +41,7 @@ from pathfuse.bench.spec import (
     _load_for_expand,
     load_dynamic,
 )
+from pathfuse.limits import check_count
 from pathfuse.result import ConfigError, PathfuseError
 from pathfuse.validate import short as _shown
 
@@ -347,6 +348,12 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         if len(set(map(canonical_json, vals))) != len(vals):
             raise ConfigError(f"{kw}: the list of values repeats a value")
         params.append((str(k), tuple(_plain(list(vals)))))
+    n_combos = 1
+    for _, vals in params:
+        n_combos *= len(vals)
+    if n_combos > 1:
+        grid = " x ".join(str(len(vals)) for _, vals in params if len(vals) > 1)
+        check_count(n_combos, "MAX_RUNS", f"{where}.params: the parameter grid ({grid})")
     entry = PlannerEntry(
         index=i, name=name, label=label.strip() if label else None, params=tuple(params),
         limits=_parse_limits(v.get("limits"), f"{where}.limits", top_limits),
@@ -449,6 +456,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
             if not _is_int(n) or n < 1:
                 raise ConfigError(f"{where}.queries.random: must be an integer >= 1, got"
                                   f" {_shown(n)}")
+            check_count(int(n), "MAX_RUNS", f"{where}.queries.random")
             d = q.get("min_distance_m", 0.0)
             if not _is_num(d) or float(d) < 0:
                 raise ConfigError(f"{where}.queries.min_distance_m: must be a number >= 0, "

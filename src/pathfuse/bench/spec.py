@@ -28,6 +28,7 @@ from pathfuse.bench.keys import (
     file_digest,
     run_key,
 )
+from pathfuse.limits import check_count
 from pathfuse.result import ConfigError, PathfuseError
 from pathfuse.validate import short as _shown
 
@@ -216,6 +217,11 @@ class Experiment:
         plain_defaults = {(p.index, k): _plain(d) for p in self.planners
                           for k, d in p.defaults_by_kind.items()}
         plain_limits = {p.index: _plain(p.limits.as_dict()) for p in self.planners}
+        total = 0
+        for entry in self.maps:  # count first: refuse a run list above MAX_RUNS unbuilt
+            per_query = sum(len(c) for p, c in combos if entry.kind in p.kinds)
+            total += len(entry.seeds) * len(self._queries(entry, entry.seeds[0])) * per_query
+        check_count(total, "MAX_RUNS", f"{self.path}: the experiment's runs")
         for entry in self.maps:
             applicable = [(p, c) for p, c in combos if entry.kind in p.kinds]
             reference = _plain(self.reference if entry.kind == "static" else None)

@@ -231,7 +231,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
         g0 = np.hypot(q[:, 0] - obs.position[0], q[:, 1] - obs.position[1]) \
             - world.obstacle_radii - world.radius
         min_obst = float(g0.min())
-    window = int(round(sc.stall_time / sc.dt)) if sc.stall_time > 0 else 0
+    window = int(round(min(sc.stall_time / sc.dt, sc.n_steps + 1))) if sc.stall_time > 0 else 0
     status = Status.TIMEOUT
     message = ""
     collision_with = None

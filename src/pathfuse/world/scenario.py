@@ -65,6 +65,7 @@ import yaml
 
 from pathfuse import validate
 from pathfuse.grid import GridMap
+from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.result import ConfigError, MapFormatError, PathfuseError
 from pathfuse.validate import short as _shown
 from pathfuse.world.geometry import segment_static_distance
@@ -290,6 +291,16 @@ def _check_scene(sc: Scenario) -> None:
     _num(sc.robot.radius, "robot.radius", ge=0)
     _num(sc.robot.max_speed, "robot.max_speed", gt=0)
     _num(sc.robot.sensing_radius, "robot.sensing_radius", gt=0)
+    # the world keeps every disc's trajectory for the whole episode: bound ticks x bodies
+    ticks = sc.time_limit / sc.dt
+    steps = ticks * (1 + len(sc.obstacles))
+    cap = limit("MAX_TICKS")
+    if not steps <= cap:
+        raise LimitError(
+            f"time_limit / dt: {sc.time_limit:g} s / {sc.dt:g} s = {ticks:.3g} ticks for "
+            f"the robot and {len(sc.obstacles)} moving discs ({steps:.3g} body-ticks) is above "
+            f"the limit of {cap} (MAX_TICKS; set the environment variable "
+            f"{env_name('MAX_TICKS')} to raise it)")
     r = sc.robot.radius
     _check_point(sc.grid, sc.start, r, "start", "the robot")
     _check_point(sc.grid, sc.goal, r, "goal", "the robot")

@@ -139,8 +139,13 @@ class GridMap:
 
         ``blocked`` characters are obstacles, every other character is free.
         """
+        if isinstance(rows, (str, bytes)) or not isinstance(rows, (list, tuple)):
+            raise MapError(f"rows must be a list of strings, got {_shown(rows)}")
         if not rows:
             raise MapError("rows must hold at least one row")
+        for i, r in enumerate(rows):
+            if not isinstance(r, str):
+                raise MapError(f"rows[{i}] must be a string, got {_shown(r)}")
         widths = {len(r) for r in rows}
         if len(widths) != 1:
             raise MapError(f"rows must all have the same length, got lengths {sorted(widths)}")

@@ -15,7 +15,10 @@ limit                      default          what it bounds
                                             while planning)
 ``MAX_RUNS``               2,000,000        runs of one experiment (seeds x queries x parameter
                                             combinations), and seeds of one ``seeds:`` value
-``MAX_TICKS``              1,000,000        ticks of one episode (``time_limit / dt``)
+``MAX_TICKS``              1,000,000        ticks of one episode times the bodies that move
+                                            (``time_limit / dt x (1 + discs)``)
+``MAX_STEPS``              10,000,000       moves of one offline plan of a stepping planner
+                                            (its path keeps every move)
 ``MAX_FILE_BYTES``         268,435,456      bytes read from one map or image file (256 MiB)
 ``MAX_YAML_BYTES``         16,777,216       bytes of one YAML file (16 MiB)
 ``MAX_YAML_NODES``         1,000,000        YAML nodes of one file *with aliases expanded*
@@ -62,6 +65,7 @@ DEFAULTS: dict[str, int] = {
     "MAX_CELLS": 8192 * 8192,
     "MAX_RUNS": 2_000_000,
     "MAX_TICKS": 1_000_000,
+    "MAX_STEPS": 10_000_000,
     "MAX_FILE_BYTES": 256 * 1024 * 1024,
     "MAX_YAML_BYTES": 16 * 1024 * 1024,
     "MAX_YAML_NODES": 1_000_000,

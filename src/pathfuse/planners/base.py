@@ -39,6 +39,7 @@ from pathfuse.field.kernels import (
 )
 from pathfuse.field.motion import MARGIN_FRAC
 from pathfuse.geometry import segment_is_clear
+from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.problem import Problem
 from pathfuse.result import Status
 
@@ -189,8 +190,20 @@ class FieldController(Controller):
             else STALL_FRAC * step
         self.clear_m = problem.robot_radius_m + MARGIN_FRAC * res
         cap = problem.budget.max_iterations
-        self.max_steps = int(cap) if cap is not None else \
-            int(math.ceil(CAP_FACTOR * (g.width + g.height) * res / step)) + 1000
+        most = limit("MAX_STEPS")
+        if cap is not None:
+            # the path keeps every move: more than MAX_STEPS moves are never taken (the
+            # result's message then names the limit)
+            self.max_steps = min(int(cap), most)
+        else:
+            moves = CAP_FACTOR * (g.width + g.height) * res / step + 1000
+            if not moves <= most:
+                raise LimitError(
+                    f"step_m: a step of {step:g} m needs up to {moves:.3g} moves to cross this "
+                    f"map ({g.width} x {g.height} cells of {res:g} m), above the limit of "
+                    f"{most} moves (MAX_STEPS; set the environment variable "
+                    f"{env_name('MAX_STEPS')} to raise it, or use a larger step)")
+            self.max_steps = int(math.ceil(moves))
         size = 1024 if self.online else min(self.max_steps, 1022) + 2
         self.buf = np.empty((size, 2))
         self.buf[0] = problem.start
@@ -259,7 +272,10 @@ class FieldController(Controller):
             return (f"local minimum {where}: moved less than {self.stall_distance_m:g} m "
                     f"over the last {self.params.stall_steps} steps")
         if status is Status.MAX_ITERATIONS:
-            return f"step cap of {self.max_steps} steps reached {where}"
+            cap = f"step cap of {self.max_steps} steps"
+            if self.max_steps == limit("MAX_STEPS"):
+                cap += " (MAX_STEPS)"
+            return f"{cap} reached {where}"
         return f"time limit reached after {steps} steps, {where}"
 
     # ------------------------------------------------------------------ online

@@ -261,7 +261,10 @@ class AStarSearcher:
                                 np.array([[ox + (sc + 0.5) * res, oy + (sr + 0.5) * res]]))
         if self._labels[sr, sc] != self._labels[gr, gc]:
             return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, 0)
-        budget = self.free_count if max_expansions is None else int(max_expansions)
+        # a search never expands more than the free cells: a larger budget (even 10**30)
+        # means no cap, and stays within the kernel's 64-bit integers
+        budget = self.free_count if max_expansions is None else \
+            min(int(max_expansions), self.free_count)
         wp = self._wp
         start = (sr + 1) * wp + sc + 1
         goal = (gr + 1) * wp + gc + 1

@@ -65,7 +65,7 @@ import yaml
 
 from pathfuse import validate
 from pathfuse.grid import GridMap
-from pathfuse.limits import LimitError, env_name, limit
+from pathfuse.limits import MAX_SEED, LimitError, env_name, limit
 from pathfuse.result import ConfigError, MapFormatError, PathfuseError
 from pathfuse.validate import short as _shown
 from pathfuse.world.geometry import segment_static_distance
@@ -340,7 +340,7 @@ def _num(v: Any, key: str, *, gt: float | None = None, ge: float | None = None) 
 
 
 def _int(v: Any, key: str, *, ge: int = 0) -> int:
-    return validate.integer(v, key, ge=ge, error=ScenarioError)
+    return validate.integer(v, key, ge=ge, le=MAX_SEED, error=ScenarioError)
 
 
 def _bool(v: Any, key: str) -> bool:

@@ -163,6 +163,8 @@ class Problem:
         return None
 
     def _blocked(self, p: tuple[float, float], cell: tuple[int, int], what: str) -> str | None:
+        from numpy import shape as np_shape
+
         g = self.grid
         r, c = cell
         if g.occupied[r, c]:
@@ -183,8 +185,20 @@ class Problem:
             clear = self.robot_radius_m + MARGIN_FRAC * g.resolution
             if not segment_is_clear(p[0], p[1], p[0], p[1], g.occupied, ox, oy, g.resolution,
                                     clear):
+                x0, y0, x1, y1 = g.bounds
+                edge = min(p[0] - x0, x1 - p[0], p[1] - y0, y1 - p[1]) < self.robot_radius_m
+                unknown = g.meta.get("unknown")
+                if edge:
+                    hit = "the map's edge"
+                elif unknown is not None and np_shape(unknown) == g.occupied.shape and \
+                        segment_is_clear(p[0], p[1], p[0], p[1], g.occupied & ~unknown, ox, oy,
+                                         g.resolution, clear):
+                    hit = ("an unknown cell of the map (unknown cells are blocked; load the "
+                           "map with unknown='free' to plan through them)")
+                else:
+                    hit = "an occupied cell"
                 return (f"{what} ({p[0]:g}, {p[1]:g}): the robot (radius "
-                        f"{self.robot_radius_m:g} m) overlaps an occupied cell or the map's edge")
+                        f"{self.robot_radius_m:g} m) overlaps {hit}")
         return None
 
     def with_start(self, start: tuple[float, float]) -> Problem:

@@ -30,15 +30,16 @@ MAIN_EPILOG = _fmt("""
 examples:
   pathfuse paper --seeds 100 --out paper-out
   pathfuse plan --map paper --seed 3 --plot plan.png
-  pathfuse plan --map den312d.map --start 10.5,70.5 --goal 60.5,8.5 --json
-  pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 500
+  pathfuse plan --map tests/data/movingai/den312d.map --start 10.5,70.5 --goal 60.5,8.5 --json
+  pathfuse scen tests/data/movingai/maze-32-32-2.map tests/data/movingai/maze-32-32-2-random-1.scen
   pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
   pathfuse dynamic --seeds 50 --moving 0 2 4 8 --out dynamic-out
   pathfuse bench experiments/fusion-sweep-r1-r2-step.yaml --db sweep.db --seeds 20
   pathfuse report sweep.db --out sweep-report
   pathfuse planners
 
-Run 'pathfuse COMMAND --help' for the options of a command.
+The paths are those of a clone of the repository.  Run 'pathfuse COMMAND --help' for the
+options of a command.
 """)
 
 
@@ -167,9 +168,26 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
 
 
+def output_file(text: str, option: str, suffix: str) -> str:
+    """An output file name checked before any work: not a folder, in a folder that exists;
+    ``suffix`` is added when the name has none (``--plot out`` writes ``out.png``)."""
+    from pathlib import Path
+
+    p = Path(text).expanduser()
+    if p.is_dir():
+        raise CliError(f"{option}: {text} is a folder; give a file name such as "
+                       f"{p / ('plan' + suffix)}")
+    if not p.suffix:
+        p = p.with_name(p.name + suffix)
+    if not p.parent.is_dir():
+        raise CliError(f"{option}: the folder {p.parent} does not exist")
+    return str(p)
+
+
 def _load_map(args: argparse.Namespace):
     from pathfuse.io import load_map
 
-    return load_map(args.map, resolution=args.resolution, seed=args.seed)
+    return load_map(args.map, resolution=args.resolution, seed=args.seed,
+                    unknown=getattr(args, "unknown", "occupied"))
 
 

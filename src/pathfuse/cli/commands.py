@@ -13,12 +13,14 @@ from pathfuse.cli.args import (
     EXIT_FAIL,
     CliError,
     _load_map,
+    output_file,
     parse_params,
     parse_planner_list,
     parse_planner_params,
     parse_point,
     parse_speed,
 )
+from pathfuse.result import PathfuseError
 
 
 # --------------------------------------------------------------------------- commands
@@ -34,6 +36,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
     start = parse_point(args.start, "--start") if args.start else PAPER_START
     goal = parse_point(args.goal, "--goal") if args.goal else PAPER_GOAL
     params = parse_params(args.param)
+    if args.plot:
+        args.plot = output_file(args.plot, "--plot", ".png")
     budget = pathfuse.Budget(time_limit_s=args.time_limit) if args.time_limit else None
     _warm_with_notice(args.planner)
     result = pathfuse.plan(grid, start, goal, planner=args.planner, budget=budget,
@@ -329,10 +333,30 @@ def parse_seeds(text: str) -> int | str | list[int]:
                        f"or a list A,B,C of seeds >= 0, got {text!r}") from None
 
 
+def _announce_imports(path: str) -> None:
+    """Name on stderr, before they run, the modules an experiment file's ``imports:`` loads
+    (an experiment file with imports is code).  A file that cannot be read is left to the
+    experiment loader, which words the error."""
+    from pathfuse.safeyaml import read_yaml
+
+    try:
+        doc = read_yaml(path, "experiment")
+    except PathfuseError:
+        return
+    imports = doc.get("imports") if isinstance(doc, dict) else None
+    if isinstance(imports, str):
+        imports = [imports]
+    if isinstance(imports, list) and imports:
+        names = ", ".join(str(i) for i in imports)
+        print(f"pathfuse bench: importing {names} (the experiment file's 'imports:' runs "
+              "this code)", file=sys.stderr, flush=True)
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
     from pathfuse.bench import SweepInterrupted, run_bench
 
     seeds = None if args.seeds is None else parse_seeds(args.seeds)
+    _announce_imports(args.experiment)
     try:
         summary = run_bench(args.experiment, args.db, seeds=seeds, workers=args.workers,
                             scheduler=args.scheduler,

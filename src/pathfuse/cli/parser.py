@@ -52,8 +52,10 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_fmt("""
 examples:
   pathfuse plan --map paper --seed 3 --planner astar --plot plan.png
-  pathfuse plan --map maps/office.yaml --start 1.0,2.5 --goal 8.2,4.0 --robot-radius 0.2
-  pathfuse plan --map room.png --resolution 0.05 --start 1,1 --goal 5,4 --json
+  pathfuse plan --map tests/data/ros/nav2_tb3_sandbox/tb3_sandbox.yaml --start -1.0,-0.5 \
+                --goal 1.5,0.5 --robot-radius 0.1
+  pathfuse plan --map tests/data/ros/nav2_tb3_sandbox/tb3_sandbox.pgm --resolution 0.05 \
+                --start 9.0,9.5 --goal 11.5,10.5 --json
   pathfuse plan --map paper --planner astar --param heuristic=octile
 
 --map accepts: 'paper' (the paper's random 15 m map, --seed N), a MovingAI .map,
@@ -69,6 +71,8 @@ a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolu
                    help="planner parameter, repeatable (e.g. --param heuristic=octile)")
     p.add_argument("--resolution", type=_float, help="metres per cell for image/.npy maps")
     p.add_argument("--seed", type=int, default=0, help="seed of --map paper (default 0)")
+    p.add_argument("--unknown", choices=["occupied", "free"], default="occupied",
+                   help="what the unknown cells of a ROS map are (default occupied)")
     p.add_argument("--robot-radius", type=_nonneg_float, default=0.0,
                    help="radius of a disc robot in metres: the path keeps this clearance "
                    "from obstacles and the map's edge (default 0)")
@@ -84,9 +88,10 @@ a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolu
         "diagonals, no corner cutting) and count how many match the file's optimal length.  "
         "Exit status 1 on any mismatch.",
         epilog=_fmt("""
-example:
-  pathfuse scen den312d.map den312d.map.scen
-  pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 1000 --heuristic octile
+examples:
+  pathfuse scen tests/data/movingai/den312d.map tests/data/movingai/den312d.map.scen
+  pathfuse scen tests/data/movingai/maze-32-32-2.map \
+                tests/data/movingai/maze-32-32-2-random-1.scen --limit 100 --heuristic euclidean
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -254,9 +259,9 @@ See experiments/*.yaml for the file format (maps, seeds, planners, swept paramet
         "report",
         help="tables and figures of a study database (Markdown, CSV, PNG, HTML)",
         description="Summarise a study database of 'pathfuse bench' per map entry and "
-        "planner configuration (and every entry pooled): runs, success rate with a 95%% "
+        "planner configuration (and every entry pooled): runs, success rate with a 95% "
         "Wilson interval, errors (never dropped), collision-free rate, path length and "
-        "planning time (mean with a 95%% t interval, median), R_length against a reference "
+        "planning time (mean with a 95% t interval, median), R_length against a reference "
         "(paired on the same problem and seed, with the number of pairs), time to goal and "
         "collisions for dynamic runs; box plots per configuration, and every swept "
         "parameter against success rate and length.  Writes report.html (self-contained), "
@@ -323,6 +328,18 @@ def _join_negative_values(argv: Sequence[str]) -> list[str]:
     return out
 
 
+def _one_line_warnings(command: str) -> None:
+    """Warnings (a ROS map's yaw, ...) as one line ``pathfuse CMD: warning: ...`` on stderr,
+    without Python's file, line and source line."""
+    import warnings
+
+    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+        text = " ".join(str(message).split())
+        print(f"pathfuse {command}: warning: {text}", file=file or sys.stderr)
+
+    warnings.showwarning = show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pathfuse`` console script."""
     parser = build_parser()
@@ -331,10 +348,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_USAGE
+    _one_line_warnings(args.command)
     try:
         return int(args.func(args) or 0)
     except PathfuseError as exc:
         print(f"pathfuse {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except (MemoryError, RecursionError) as exc:  # a last guard: the limits should come first
+        what = "out of memory" if isinstance(exc, MemoryError) else "input nested too deeply"
+        print(f"pathfuse {args.command}: error: {what}", file=sys.stderr)
         return EXIT_USAGE
     except BrokenPipeError:  # output piped into e.g. `head`, which closed early
         import os
@@ -342,7 +364,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except OSError as exc:
-        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        where = f" {exc.filename}:" if getattr(exc, "filename", None) else ""
         print(f"pathfuse {args.command}: error:{where} {exc.strerror or exc}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:

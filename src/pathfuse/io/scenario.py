@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pathfuse.grid import GridMap
+from pathfuse.limits import read_capped
 from pathfuse.result import MapFormatError
 from pathfuse.validate import short as _shown
 
@@ -77,7 +78,7 @@ class ScenProblem:
 
 def _lines(path: Path) -> list[str]:
     try:
-        data = path.read_bytes()
+        data = read_capped(path, "the scenario file")
     except FileNotFoundError:
         raise MapFormatError(f"{path}: no such scenario file") from None
     except IsADirectoryError:
@@ -97,8 +98,12 @@ def _check_version(path: Path, lines: list[str]) -> None:
         raise MapFormatError(f"{path}, line 1: scenario file is empty")
     parts = lines[0].split()
     if len(parts) != 2 or parts[0] != "version" or parts[1] not in ("1", "1.0"):
+        hint = ""
+        if parts[:1] == ["type"] or path.suffix.lower() == ".map":
+            hint = " (this is a MovingAI map (.map), not a scenario file: give the .map first)"
         raise MapFormatError(
-            f"{path}, line 1: expected 'version 1' or 'version 1.0', got {_shown(lines[0][:60])}"
+            f"{path}, line 1: expected 'version 1' or 'version 1.0', "
+            f"got {_shown(lines[0][:60])}{hint}"
         )
 
 
@@ -207,4 +212,6 @@ def read_scen(path: str | os.PathLike[str], grid: GridMap) -> list[ScenProblem]:
                 optimal_length=opt * res,
             )
         )
+    if not out:
+        raise MapFormatError(f"{path}: scenario file holds no problem line (only its header)")
     return out

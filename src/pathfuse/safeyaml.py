@@ -120,16 +120,24 @@ def _loader_class() -> Any:
         def construct_mapping(self, node: Any, deep: bool = False) -> dict[Any, Any]:
             if not isinstance(node, yaml.MappingNode):
                 return super().construct_mapping(node, deep=deep)  # raises the usual error
+            # keys written in this mapping must be unique; keys brought in by a merge
+            # ("<<: *base") come first and may be overridden by them
+            merge = "tag:yaml.org,2002:merge"
+            n_own = sum(1 for k, _ in node.value if k.tag != merge)
             self.flatten_mapping(node)
+            n_merged = len(node.value) - n_own
             out: dict[Any, Any] = {}
-            for knode, vnode in node.value:
+            own: set[Any] = set()
+            for i, (knode, vnode) in enumerate(node.value):
                 if not isinstance(knode, yaml.ScalarNode):
                     kind = "a list" if isinstance(knode, yaml.SequenceNode) else "a mapping"
                     raise _Refused(f"a mapping key must be text or a number, got {kind}",
                                    knode.start_mark)
                 k = self.construct_object(knode, deep=deep)
-                if k in out:
-                    raise _Refused(f"duplicate key {short(k)}", knode.start_mark)
+                if i >= n_merged:
+                    if k in own:
+                        raise _Refused(f"duplicate key {short(k)}", knode.start_mark)
+                    own.add(k)
                 out[k] = self.construct_object(vnode, deep=deep)
             return out
 

@@ -44,7 +44,7 @@ import numpy as np
 
 from pathfuse.grid import GridMap
 from pathfuse.limits import check_cells
-from pathfuse.result import MapError, MapFormatError
+from pathfuse.result import MapError, MapFormatError, PathfuseError
 from pathfuse.validate import short as _shown
 
 __all__ = ["read_image", "read_npy", "load_pixels", "IMAGE_SUFFIXES"]
@@ -86,9 +86,11 @@ def load_pixels(
     try:
         with Image.open(path) as im:
             w, h = im.size  # from the header: check before decoding
-            check_cells(h, w, f"{context}{path}: image", MapFormatError)
+            check_cells(h, w, f"{context}{path}: image")
             im.load()
             img = im
+    except PathfuseError:
+        raise
     except UnidentifiedImageError:
         raise MapFormatError(f"{context}{path}: not a readable image (unknown or corrupt format)") \
             from None
@@ -264,9 +266,11 @@ def read_npy(
         # the header first (a memory map reads no data), so a huge array is refused unread
         head = np.load(path, allow_pickle=False, mmap_mode="r")
         if isinstance(head, np.ndarray) and head.ndim == 2:
-            check_cells(head.shape[0], head.shape[1], f"{path}: array", MapFormatError)
+            check_cells(head.shape[0], head.shape[1], f"{path}: array")
         arr = np.array(head) if isinstance(head, np.memmap) else head
         del head
+    except PathfuseError:
+        raise
     except ValueError as exc:
         msg = str(exc)
         if "allow_pickle" in msg or "pickle" in msg.lower() or "Python objects" in msg:

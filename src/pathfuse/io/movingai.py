@@ -199,7 +199,7 @@ def read_movingai(
         got = lines[i].decode("ascii", "replace")
         raise MapFormatError(f"{path}, line {i + 1}: expected 'map', got {_shown(got)}")
     height, width = sizes["height"], sizes["width"]
-    check_cells(height, width, f"{path}: header", MapFormatError)
+    check_cells(height, width, f"{path}: header")
     first_row = i + 1
     rows = lines[first_row:first_row + height]
     # a final newline leaves one empty string at the end: ignore trailing blank lines

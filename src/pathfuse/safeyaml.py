@@ -180,8 +180,9 @@ def load_yaml(text: str | bytes, where: str,
     cls = _loader_class()
     cls.max_nodes = limit("MAX_YAML_NODES")
     cls.max_depth = limit("MAX_YAML_DEPTH")
-    loader = cls(text)
+    loader = None
     try:
+        loader = cls(text)  # reads the stream: may raise a ReaderError
         return loader.get_single_data()
     except _Refused as exc:
         if exc.name is not None:
@@ -197,7 +198,8 @@ def load_yaml(text: str | bytes, where: str,
     except RecursionError:  # pragma: no cover - the depth limit comes first
         raise LimitError(f"{where}: nested too deeply") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def read_yaml(path: str | os.PathLike[str], what: str = "YAML",

@@ -277,9 +277,12 @@ def read_npy(
             raise MapFormatError(
                 f"{path}: holds an object (pickled) array; save a bool or numeric array"
             ) from None
-        raise MapFormatError(f"{path}: not a valid .npy file ({msg})") from None
+        raise MapFormatError(f"{path}: not a valid .npy file ({_shown(msg, 120)})") from None
     except (OSError, EOFError) as exc:
         raise MapFormatError(f"{path}: cannot read .npy file ({exc})") from None
+    except Exception as exc:  # noqa: BLE001 - numpy's header parser raises what Python's does
+        raise MapFormatError(f"{path}: not a valid .npy file (a malformed header: "
+                             f"{type(exc).__name__})") from None
     if not isinstance(arr, np.ndarray):
         raise MapFormatError(f"{path}: holds {type(arr).__name__}, not a single array")
     if arr.ndim != 2:

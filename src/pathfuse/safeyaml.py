@@ -143,8 +143,6 @@ def _loader_class() -> Any:
 
     Loader.add_implicit_resolver("tag:yaml.org,2002:float", FLOAT_RE,
                                  list("-+0123456789."))
-    Loader.add_constructor("tag:yaml.org,2002:map",
-                           lambda loader, node: loader.construct_mapping(node))
     _LOADER = Loader
     return Loader
 

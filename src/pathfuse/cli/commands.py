@@ -21,6 +21,7 @@ from pathfuse.cli.args import (
     parse_speed,
 )
 from pathfuse.result import PathfuseError
+from pathfuse.validate import short as _shown
 
 
 # --------------------------------------------------------------------------- commands
@@ -330,7 +331,7 @@ def parse_seeds(text: str) -> int | str | list[int]:
         return n
     except ValueError:
         raise CliError(f"--seeds: expected a count N >= 1, a range A:B with 0 <= A < B, "
-                       f"or a list A,B,C of seeds >= 0, got {text!r}") from None
+                       f"or a list A,B,C of seeds >= 0, got {_shown(text)}") from None
 
 
 def _announce_imports(path: str) -> None:

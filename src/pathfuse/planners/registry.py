@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from pathfuse.result import ConfigError
+from pathfuse.validate import short as _shown
 
 if TYPE_CHECKING:
     from pathfuse.planners.base import Controller
@@ -158,7 +159,7 @@ def get_planner(name: str) -> PlannerSpec:
         return REGISTRY[_ALIASES.get(name, name)]
     except (KeyError, TypeError):
         raise ConfigError(
-            f"unknown planner {name!r}; choose one of: {', '.join(planner_names())}"
+            f"unknown planner {_shown(name)}; choose one of: {', '.join(planner_names())}"
         ) from None
 
 

@@ -84,6 +84,7 @@ from pathfuse.search.kernel import (
     _astar_kernel,
     _trace,
 )
+from pathfuse.validate import short as _shown
 
 __all__ = [
     "AStarSearcher",
@@ -229,7 +230,7 @@ class AStarSearcher:
         """
         if heuristic not in HEURISTICS:
             raise ConfigError(f"heuristic: must be one of {', '.join(map(repr, HEURISTICS))}, "
-                              f"got {heuristic!r}")
+                              f"got {_shown(heuristic)}")
         h, w = self.shape
         (sr, sc), (gr, gc) = (int(v) for v in start_cell), (int(v) for v in goal_cell)
         for what, r, c in (("start", sr, sc), ("goal", gr, gc)):

@@ -31,6 +31,7 @@ from pathfuse.result import ConfigError
 from pathfuse.stats import markdown_table as _md
 from pathfuse.stats import mean_ci, wilson_ci
 from pathfuse.stats import write_csv as _write_csv
+from pathfuse.validate import short as _shown
 
 __all__ = [
     "PAPER_PLANNERS",
@@ -100,7 +101,7 @@ class PaperConfig:
 
     def __post_init__(self) -> None:
         if not isinstance(self.n_seeds, int) or self.n_seeds < 1:
-            raise ConfigError(f"n_seeds: must be a positive integer, got {self.n_seeds!r}")
+            raise ConfigError(f"n_seeds: must be a positive integer, got {_shown(self.n_seeds)}")
         if "fusion" not in self.planners:
             raise ConfigError("planners: must include 'fusion' (R_length is relative to it)")
 

@@ -67,6 +67,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.result import PathfuseError, QueryError
+from pathfuse.validate import short as _shown
 from pathfuse.world.geometry import (
     disc_sweep_gaps,
     point_segment_distance,
@@ -233,9 +234,9 @@ class World:
         try:
             v = np.asarray(action, dtype=np.float64).reshape(-1)
         except (TypeError, ValueError):
-            raise QueryError(f"action must be a velocity (vx, vy), got {action!r}") from None
+            raise QueryError(f"action must be a velocity (vx, vy), got {_shown(action)}") from None
         if v.shape != (2,) or not np.all(np.isfinite(v)):
-            raise QueryError(f"action must be a finite velocity (vx, vy), got {action!r}")
+            raise QueryError(f"action must be a finite velocity (vx, vy), got {_shown(action)}")
         s = math.hypot(v[0], v[1])
         if s > self.max_speed:
             return v * (self.max_speed / s), True

@@ -257,3 +257,9 @@ def test_os_error_names_the_file(tmp_path):
         pytest.skip("running as root")
     one_line(run("plan", "--map", "paper", "--plot", tmp_path / "ro" / "p.png"), 2,
              f"{tmp_path / 'ro' / 'p.png'}: Permission denied")
+
+
+def test_dynamic_with_too_many_discs(tmp_path):
+    proc = run("dynamic", "--moving", "100000", "--seeds", "1", "--out", tmp_path / "d")
+    one_line(proc, 2, "moving: 100000 moving discs", "6e+07 body-ticks", "MAX_TICKS")
+    assert not (tmp_path / "d").exists()      # refused before any folder or database

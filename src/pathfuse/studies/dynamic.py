@@ -131,6 +131,13 @@ class DynamicConfig:
             raise ConfigError(f"moving: expected a list of integers >= 0, got"
                               f" {_shown(self.moving)}")
         object.__setattr__(self, "moving", tuple(dict.fromkeys(int(k) for k in moving)))
+        import inspect
+
+        from pathfuse.world.generate import check_body_ticks, generate_scenarios
+
+        defaults = inspect.signature(generate_scenarios).parameters
+        check_body_ticks(defaults["time_limit"].default, defaults["dt"].default,
+                         max(self.moving))
         try:
             lo, hi = (float(v) for v in self.speed_range)
             ok = math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi

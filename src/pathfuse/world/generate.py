@@ -46,6 +46,7 @@ import numpy as np
 
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.grid import GridMap
+from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.planners.global_astar import route as global_route
 from pathfuse.result import ConfigError
 from pathfuse.validate import short as _shown
@@ -157,6 +158,22 @@ def _valid(grid: GridMap, ob: ObstacleSpec, start: np.ndarray, goal: np.ndarray,
     return bool(np.hypot(*(p0 - goal)) - ob.radius - robot_r >= min_goal_gap)
 
 
+def check_body_ticks(time_limit: Any, dt: Any, moving: int, key: str = "moving") -> None:
+    """Refuse episodes of more than ``MAX_TICKS`` body-ticks (``time_limit / dt x (1 +
+    moving)``) before any disc is placed; values that are not numbers are left to the
+    scenario's own checks."""
+    try:
+        steps = float(time_limit) / float(dt) * (1 + int(moving))
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+        return
+    cap = limit("MAX_TICKS")
+    if steps > cap:
+        raise LimitError(
+            f"{key}: {int(moving)} moving discs over {float(time_limit):g} s in ticks of "
+            f"{float(dt):g} s are {steps:.3g} body-ticks, above the limit of {cap} (MAX_TICKS; "
+            f"set the environment variable {env_name('MAX_TICKS')} to raise it)")
+
+
 def generate_scenarios(
     n_scenarios: int,
     moving: int = 3,
@@ -240,6 +257,7 @@ def generate_scenarios(
     if placement not in PLACEMENTS:
         raise ConfigError(f"placement must be one of {', '.join(PLACEMENTS)}, "
                           f"got {_shown(placement)}")
+    check_body_ticks(time_limit, dt, moving)  # before placing any disc
     robot = robot or RobotSpec()
     choice = resolve_planner_choice(planner)
     fixed_grid: GridMap | None = None

@@ -146,7 +146,14 @@ def test_parameter_grid(tmp_path):
 def test_map_linked_to_dev_zero(tmp_path):
     (tmp_path / "zero.map").symlink_to("/dev/zero")
     one_line(run("plan", "--map", tmp_path / "zero.map", "--start", "1,1", "--goal", "2,2"), 2,
-             "zero.map: the map file is larger than the limit of 268435456 bytes",
+             "zero.map: the map file is a device, not a file")
+
+
+def test_map_larger_than_the_file_limit(tmp_path):
+    p = write(tmp_path, "big.map", "type octile\nheight 1\nwidth 4000\nmap\n" + "." * 4000 + "\n")
+    one_line(run("plan", "--map", p, "--start", "1,0.5", "--goal", "2,0.5",
+                 env={"PATHFUSE_MAX_FILE_BYTES": "1000"}), 2,
+             "big.map: the map file is larger than the limit of 1000 bytes",
              "PATHFUSE_MAX_FILE_BYTES")
 
 

@@ -137,12 +137,18 @@ def read_capped(path: str | os.PathLike[str], what: str, name: str = "MAX_FILE_B
                 error: type[PathfuseError] = LimitError) -> bytes:
     """The bytes of ``path``, reading at most limit ``name`` of them.
 
-    A longer file (or an endless one, such as a link to ``/dev/zero``) is
-    refused after reading one byte more than the limit, so it never fills
-    memory.  ``OSError`` propagates for the caller to word.
+    A longer file (or an endless one, such as a pipe) is refused after
+    reading one byte more than the limit, so it never fills memory; a device
+    (a link to ``/dev/zero``) is refused unread.  ``OSError`` propagates for
+    the caller to word.
     """
+    import stat
+
     cap = limit(name)
     with open(Path(path), "rb") as fh:
+        mode = os.fstat(fh.fileno()).st_mode
+        if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+            raise error(f"{path}: {what} is a device, not a file")
         data = fh.read(cap + 1)
     if len(data) > cap:
         raise error(f"{path}: {what} is larger than the limit of {cap} bytes "

@@ -86,10 +86,12 @@ def test_obstacles_keep_their_margin(planner):
     assert ys.min() > 1.0
 
 
-@pytest.mark.parametrize("planner", [p for p in PLANNERS if p not in ("astar-replan",)])
-def test_online_from_the_edge(planner):
-    sc = {"map": {"rows": ["......"] * 3}, "start": [0.0, 1.5], "goal": [5.5, 1.5],
-          "robot": {"radius": 0.0, "max_speed": 1.0}, "time_limit": 30}
+@pytest.mark.parametrize("radius", [0.0, 0.2])
+@pytest.mark.parametrize("planner", PLANNERS)
+def test_online_from_the_edge(planner, radius):
+    # a point robot on the edge, or a disc touching it
+    sc = {"map": {"rows": ["......"] * 3}, "start": [radius, 1.5], "goal": [5.5, 1.5],
+          "robot": {"radius": radius, "max_speed": 1.0}, "time_limit": 30}
     ep = pathfuse.simulate(sc, planner=planner)
     assert ep.status is pathfuse.Status.SUCCESS, ep.message
     assert math.isclose(ep.positions[-1][0], 5.5, abs_tol=0.3)

@@ -130,8 +130,13 @@ def _run_serial(exp: Experiment, todo: Sequence[RunSpec], sink: Sink) -> None:
             sink.write(pending)
 
 
-def _worker_init(imports: Sequence[str]) -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the client handles Ctrl-C
+def _worker_init(imports: Sequence[str], client_pid: int | None = None) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the client handles Ctrl-C and SIGTERM;
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)  # it stops the workers itself
+    if client_pid is not None:  # die with the client, even after kill -9
+        from pathfuse.bench.lifeline import watch_client
+
+        watch_client(client_pid)
     ensure_imports(imports)
 
 
@@ -179,13 +184,16 @@ class _Pool:
 
     def __init__(self, workers: int, imports: Sequence[str]) -> None:
         self.ex = ProcessPoolExecutor(max_workers=workers, mp_context=_mp_context(),
-                                      initializer=_worker_init, initargs=(list(imports),))
+                                      initializer=_worker_init,
+                                      initargs=(list(imports), os.getpid()))
         try:
             pings = [self.ex.submit(_ping) for _ in range(workers)]
             for f in pings:
                 f.result(timeout=300)
-        except BrokenProcessPool:
+        except BaseException as exc:  # Ctrl-C/SIGTERM while starting: stop the workers
             self.kill()
+            if not isinstance(exc, BrokenProcessPool):
+                raise
             raise WorkersCannotStart(
                 "the worker processes die as they start (see the errors above); run with "
                 "workers=1 to see the problem in this process") from None
@@ -201,9 +209,9 @@ class _Pool:
     def kill(self) -> None:
         procs = list(getattr(self.ex, "_processes", {}).values())
         self.ex.shutdown(wait=False, cancel_futures=True)
-        for p in procs:  # only the workers this pool started
+        for p in procs:  # only the workers this pool started (they ignore SIGTERM)
             if p.is_alive():
-                p.terminate()
+                p.kill()
         for p in procs:
             p.join(timeout=5)
 

@@ -108,9 +108,12 @@ class SweepSummary:
 class SweepInterrupted(KeyboardInterrupt):
     """Ctrl-C during a sweep; ``.summary`` holds what was stored before it."""
 
-    def __init__(self, summary: SweepSummary) -> None:
+    def __init__(self, summary: SweepSummary, signame: str = "") -> None:
         super().__init__(str(summary))
         self.summary = summary
+        self.signame = signame
+        """``"SIGTERM"`` when a SIGTERM (made a :class:`~pathfuse.bench.lifeline.Terminated`)
+        stopped the sweep, ``""`` for Ctrl-C."""
 
 
 def default_workers() -> int:
@@ -322,11 +325,11 @@ def run_experiment(
                 with _main_without_file():
                     _run_pool(exp, todo, sink, nworkers, batch_size)
             state = "finished"
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as exc:
             state = "interrupted"
             summary.interrupted = True
             summary.wall_s = time.perf_counter() - t0
-            raise SweepInterrupted(summary) from None
+            raise SweepInterrupted(summary, getattr(exc, "signame", "")) from None
         finally:
             bar.close()
             summary.wall_s = time.perf_counter() - t0

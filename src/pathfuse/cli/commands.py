@@ -340,9 +340,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
                             retry_errors=args.retry_errors, batch_size=args.batch_size)
     except SweepInterrupted as exc:
         print(exc.summary, flush=True)
-        print("pathfuse bench: interrupted; run the same command again to resume",
-              file=sys.stderr)
-        return 130
+        sig = getattr(exc, "signame", "")
+        how = f"terminated ({sig})" if sig else "interrupted"
+        print(f"pathfuse bench: {how}; run the same command again to resume", file=sys.stderr)
+        return 143 if sig == "SIGTERM" else 130
     print(summary)
     return 0 if summary.errors == 0 else EXIT_FAIL
 

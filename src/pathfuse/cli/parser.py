@@ -331,6 +331,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_USAGE
+    from pathfuse.bench.lifeline import terminate_like_ctrl_c
+
+    terminate_like_ctrl_c()  # SIGTERM ends a command like Ctrl-C: one line, stored runs kept
     try:
         return int(args.func(args) or 0)
     except PathfuseError as exc:
@@ -345,9 +348,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
         print(f"pathfuse {args.command}: error:{where} {exc.strerror or exc}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print(f"pathfuse {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        sig = getattr(exc, "signame", "")
+        how = f"terminated ({sig})" if sig else "interrupted"
+        summary = getattr(exc, "summary", None)  # a sweep: its finished runs are stored
+        tail = ""
+        if summary is not None:
+            tail = (f"; {summary.skipped + summary.ran}/{summary.total} runs stored in "
+                    f"{summary.db_path}, run the same command again to finish the rest")
+        print(f"pathfuse {args.command}: {how}{tail}", file=sys.stderr)
+        return 143 if sig == "SIGTERM" else 130
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -37,6 +37,7 @@ from pathfuse.bench.experiment import (
     canonical_json,
     load_experiment,
 )
+from pathfuse.bench.lock import StudyLocked, study_lock
 from pathfuse.bench.pool import (
     WorkersCannotStart,
     _main_without_file,
@@ -49,7 +50,7 @@ from pathfuse.bench.progress import ProgressBar
 from pathfuse.bench.store import ResultStore
 from pathfuse.result import ConfigError
 
-__all__ = ["run_bench", "run_experiment", "SweepSummary", "SweepInterrupted",
+__all__ = ["run_bench", "run_experiment", "SweepSummary", "SweepInterrupted", "StudyLocked",
            "WorkersCannotStart", "make_batches", "default_workers"]
 
 CRASH_TEXT = ("WorkerCrashed: the worker process died while running this run "
@@ -285,13 +286,29 @@ def run_experiment(
     """
     t0 = time.perf_counter() if started is None else started
     _check_counts(workers, batch_size)
-    experiment_path = exp.path
     runs = exp.expand()
     nworkers = default_workers() if workers is None else workers
     if scheduler is not None:
         _connect_check(scheduler)
     own_store = not isinstance(db_path, ResultStore)
-    store = db_path if isinstance(db_path, ResultStore) else ResultStore(db_path)
+    # one sweep at a time per database: a second one is refused before it opens the store
+    if not isinstance(db_path, ResultStore) and str(db_path) != ":memory:":
+        from pathfuse.bench.dbcheck import check_study_file
+
+        check_study_file(db_path, write=True)  # a folder, damaged, foreign, read-only
+    with study_lock(db_path.path if isinstance(db_path, ResultStore) else db_path):
+        store = db_path if isinstance(db_path, ResultStore) else ResultStore(db_path,
+                                                                             check=False)
+        return _run_locked(exp, runs, store, own_store, nworkers, scheduler, progress,
+                           retry_errors, batch_size, stream, on_start, t0, label)
+
+
+def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_store: bool,
+                nworkers: int, scheduler: Any, progress: bool | None, retry_errors: bool,
+                batch_size: int | None, stream: Any,
+                on_start: Callable[[int, int], None] | None, t0: float,
+                label: str | None) -> SweepSummary:
+    experiment_path = exp.path
     summary = SweepSummary(experiment=exp.name, db_path=str(store.path), total=len(runs),
                            workers=nworkers,
                            scheduler=_scheduler_name(scheduler))

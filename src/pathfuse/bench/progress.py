@@ -118,6 +118,13 @@ class ProgressBar:
             self.stream.write(text + "\n")
         self.stream.flush()
 
+    def notice(self, text: str) -> None:
+        """Write one line (``pathfuse: TEXT``) above the bar, even when the bar is off."""
+        prefix = "\r\x1b[K" if self.tty and self.enabled and not self._closed else ""
+        self.stream.write(f"{prefix}pathfuse: {text}\n")
+        self.stream.flush()
+        self._last = -1e9  # redraw the bar at the next update
+
     def close(self) -> None:
         """Write the final line (and end it with a newline on a terminal)."""
         if self._closed:

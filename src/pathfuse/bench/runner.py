@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from pathfuse.bench.dask_backend import DEFAULT_WORKER_WAIT_S, ClusterLost, run_dask
 from pathfuse.bench.experiment import (
     Experiment,
     RunSpec,
@@ -41,7 +42,6 @@ from pathfuse.bench.lock import StudyLocked, study_lock
 from pathfuse.bench.pool import (
     WorkersCannotStart,
     _main_without_file,
-    _run_dask,
     _run_pool,
     _run_serial,
     make_batches,
@@ -51,6 +51,7 @@ from pathfuse.bench.store import ResultStore
 from pathfuse.result import ConfigError
 
 __all__ = ["run_bench", "run_experiment", "SweepSummary", "SweepInterrupted", "StudyLocked",
+           "ClusterLost",
            "WorkersCannotStart", "make_batches", "default_workers"]
 
 CRASH_TEXT = ("WorkerCrashed: the worker process died while running this run "
@@ -155,6 +156,10 @@ class _Sink:
                     self.cfg_ids[k] = store.ensure_planner_config(r.config, r.planner,
                                                                   r.settings)
 
+    def notice(self, text: str) -> None:
+        """One line on the progress bar's stream (the cluster lost its workers, ...)."""
+        self.bar.notice(text)
+
     def complete(self, row: dict[str, Any]) -> dict[str, Any]:
         r = self.specs[row["run_key"]]
         out = dict(row)
@@ -207,6 +212,7 @@ def run_bench(
     batch_size: int | None = None,
     stream: Any = None,
     on_start: Callable[[int, int], None] | None = None,
+    worker_wait_s: float = DEFAULT_WORKER_WAIT_S,
 ) -> SweepSummary:
     """Run (or resume) the sweep of an experiment file into a result database.
 
@@ -233,6 +239,9 @@ def run_bench(
         Where the progress bar writes (default ``sys.stderr``).
     on_start : callable, optional
         Called with ``(total, to_run)`` once the run list is known.
+    worker_wait_s : float
+        With ``scheduler``: how long to wait when the cluster has no worker left
+        before giving up with :class:`ClusterLost` (it says so after 5 s).
 
     Returns
     -------
@@ -244,14 +253,20 @@ def run_bench(
         A bad experiment file, ``workers``, ``scheduler`` or database (one line
         naming the key).
     SweepInterrupted
-        Ctrl-C; everything finished before it is stored.
+        Ctrl-C (or SIGTERM, see :mod:`pathfuse.bench.lifeline`); everything finished
+        before it is stored.
+    ClusterLost
+        The Dask scheduler was lost, or no worker was left for ``worker_wait_s``; the
+        runs that finished are stored, the others stay missing (the same call resumes).
+    StudyLocked
+        Another sweep is writing the same database (:mod:`pathfuse.bench.lock`).
     """
     t0 = time.perf_counter()
     _check_counts(workers, batch_size)
     exp = load_experiment(experiment_path, seeds=seeds)
     return run_experiment(exp, db_path, workers, scheduler, progress,
                           retry_errors=retry_errors, batch_size=batch_size, stream=stream,
-                          on_start=on_start, started=t0)
+                          on_start=on_start, started=t0, worker_wait_s=worker_wait_s)
 
 
 def _check_counts(workers: Any, batch_size: Any) -> None:
@@ -276,6 +291,7 @@ def run_experiment(
     on_start: Callable[[int, int], None] | None = None,
     started: float | None = None,
     label: str | None = None,
+    worker_wait_s: float = DEFAULT_WORKER_WAIT_S,
 ) -> SweepSummary:
     """Run (or resume) a validated :class:`Experiment` into a result database.
 
@@ -300,14 +316,15 @@ def run_experiment(
         store = db_path if isinstance(db_path, ResultStore) else ResultStore(db_path,
                                                                              check=False)
         return _run_locked(exp, runs, store, own_store, nworkers, scheduler, progress,
-                           retry_errors, batch_size, stream, on_start, t0, label)
+                           retry_errors, batch_size, stream, on_start, t0, label,
+                           worker_wait_s)
 
 
 def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_store: bool,
                 nworkers: int, scheduler: Any, progress: bool | None, retry_errors: bool,
                 batch_size: int | None, stream: Any,
                 on_start: Callable[[int, int], None] | None, t0: float,
-                label: str | None) -> SweepSummary:
+                label: str | None, worker_wait_s: float) -> SweepSummary:
     experiment_path = exp.path
     summary = SweepSummary(experiment=exp.name, db_path=str(store.path), total=len(runs),
                            workers=nworkers,
@@ -335,7 +352,8 @@ def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_st
             if not todo:
                 pass
             elif scheduler is not None:
-                summary.workers = _run_dask(exp, todo, sink, scheduler, batch_size)
+                summary.workers = run_dask(exp, todo, sink, scheduler, batch_size,
+                                           worker_wait_s)
             elif nworkers == 1 or len(todo) == 1:
                 _run_serial(exp, todo, sink)
             else:
@@ -347,6 +365,11 @@ def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_st
             summary.interrupted = True
             summary.wall_s = time.perf_counter() - t0
             raise SweepInterrupted(summary, getattr(exc, "signame", "")) from None
+        except ClusterLost as exc:
+            state = "cluster-lost"
+            summary.interrupted = True
+            exc.summary = summary
+            raise
         finally:
             bar.close()
             summary.wall_s = time.perf_counter() - t0

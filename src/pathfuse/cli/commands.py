@@ -329,21 +329,42 @@ def parse_seeds(text: str) -> int | str | list[int]:
                        f"or a list A,B,C of seeds >= 0, got {text!r}") from None
 
 
+def _quiet_dask_logs() -> None:
+    """Dask logs a lost scheduler as tracebacks; the command says it in one line instead."""
+    import logging
+
+    try:
+        import distributed  # type: ignore[import-not-found]  # noqa: F401 - sets its levels
+    except ImportError:
+        return  # run_bench says how to install it
+    for name in ["distributed", *logging.root.manager.loggerDict]:
+        if name == "distributed" or name.startswith("distributed."):
+            logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
-    from pathfuse.bench import SweepInterrupted, run_bench
+    from pathfuse.bench import ClusterLost, SweepInterrupted, run_bench
 
     seeds = None if args.seeds is None else parse_seeds(args.seeds)
+    if args.scheduler:  # a lost cluster is one line of ours, not Dask's tracebacks
+        _quiet_dask_logs()
     try:
         summary = run_bench(args.experiment, args.db, seeds=seeds, workers=args.workers,
                             scheduler=args.scheduler,
                             progress=False if args.no_progress else None,
-                            retry_errors=args.retry_errors, batch_size=args.batch_size)
+                            retry_errors=args.retry_errors, batch_size=args.batch_size,
+                            worker_wait_s=args.worker_wait)
     except SweepInterrupted as exc:
         print(exc.summary, flush=True)
         sig = getattr(exc, "signame", "")
         how = f"terminated ({sig})" if sig else "interrupted"
         print(f"pathfuse bench: {how}; run the same command again to resume", file=sys.stderr)
         return 143 if sig == "SIGTERM" else 130
+    except ClusterLost as exc:
+        if exc.summary is not None:
+            print(exc.summary, flush=True)
+        print(f"pathfuse bench: error: {exc}", file=sys.stderr)
+        return EXIT_FAIL
     print(summary)
     return 0 if summary.errors == 0 else EXIT_FAIL
 

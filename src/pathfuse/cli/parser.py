@@ -242,6 +242,9 @@ See experiments/*.yaml for the file format (maps, seeds, planners, swept paramet
                    "process)")
     b.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                    help="run on a Dask distributed cluster (pip install 'pathfuse[dask]')")
+    b.add_argument("--worker-wait", type=_positive_float, default=60.0, metavar="SECONDS",
+                   help="with --scheduler: how long to wait when the cluster has no worker "
+                   "left before stopping (default 60; it says so after 5 s)")
     b.add_argument("--batch-size", type=_positive_int, default=None,
                    help="runs per task (default: about 8 tasks per worker, at most 64)")
     b.add_argument("--retry-errors", action="store_true",

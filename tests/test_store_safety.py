@@ -94,7 +94,7 @@ def test_an_intact_study_passes_the_check_and_resumes(finished, tmp_path):
     assert check_study_file(db, write=True) is False
     p = cli("bench", "exp.yaml", "--db", "study.db", "--workers", "1", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-    assert "0 runs" in p.stdout and "80 already stored" in p.stdout
+    assert "nothing to run, all 80 runs are already stored in study.db" in p.stdout
 
 
 # --------------------------------------------------------------------------- not ours to write
@@ -221,7 +221,7 @@ def test_a_second_sweep_on_the_same_database_is_refused(tmp_path):
         assert c.execute("SELECT COUNT(*) FROM pathfuse_sessions").fetchone()[0] == 1
     assert not lock_path(tmp_path / "s.db").exists()  # released and removed at the end
     again = cli(*cmd[3:], cwd=tmp_path)  # after it: the same command is free to run
-    assert again.returncode == 0 and "100 already stored" in again.stdout
+    assert again.returncode == 0 and "all 100 runs are already stored" in again.stdout
 
 
 def test_the_lock_dies_with_a_killed_sweep(tmp_path):

@@ -24,7 +24,6 @@ complete.
 from __future__ import annotations
 
 import os
-import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
@@ -46,8 +45,9 @@ from pathfuse.bench.pool import (
     _run_serial,
     make_batches,
 )
-from pathfuse.bench.progress import ProgressBar
+from pathfuse.bench.progress import ProgressBar, progress_enabled
 from pathfuse.bench.store import ResultStore
+from pathfuse.bench.warmup import warm_kernels
 from pathfuse.result import ConfigError
 
 __all__ = ["run_bench", "run_experiment", "SweepSummary", "SweepInterrupted", "StudyLocked",
@@ -76,6 +76,8 @@ class SweepSummary:
     workers: int = 1
     scheduler: str | None = None
     error_samples: list[str] = field(default_factory=list)
+    stored_errors: int = 0
+    """Runs skipped because they are stored as ``ERROR`` (``retry_errors`` runs them)."""
 
     @property
     def runs_per_s(self) -> float:
@@ -94,10 +96,18 @@ class SweepSummary:
 
     def __str__(self) -> str:
         where = self.scheduler or (f"{self.workers} worker" + ("s" if self.workers > 1 else ""))
+        stored = self.skipped + self.ran
+        if self.ran == 0 and self.complete and not self.interrupted:
+            errs = (f"; {self.stored_errors} of them raised (ERROR), --retry-errors runs "
+                    "them again") if self.stored_errors else ""
+            return (f"{self.experiment}: nothing to run, all {self.total} runs are already "
+                    f"stored in {self.db_path} ('pathfuse report {self.db_path}' summarises "
+                    f"them){errs}")
         head = (f"{self.experiment}: {self.ran} runs in {self.wall_s:.1f} s "
                 f"({self.runs_per_s:.1f} runs/s, {where}); {self.skipped} already stored; "
-                f"{self.skipped + self.ran}/{self.total} in {self.db_path}")
-        tail = f"\n  solved {self.succeeded}, not solved {self.failed}, errors {self.errors}"
+                f"{stored}/{self.total} in {self.db_path}")
+        tail = (f"\n  of the {self.ran} run now: solved {self.succeeded}, not solved "
+                f"{self.failed}, errors {self.errors}")
         if self.crashed:
             tail += f" ({self.crashed} crashed their worker)"
         if self.interrupted:
@@ -230,7 +240,9 @@ def run_bench(
         ``"tcp://HOST:PORT"`` of a Dask scheduler (or a ``distributed.Client``);
         ``workers`` is then ignored.
     progress : bool or None
-        Show a progress bar on stderr (None: only when stderr is a terminal).
+        False shows nothing; True or None show the progress display on ``stream``
+        (:mod:`pathfuse.bench.progress`: a live bar on a terminal, a few plain lines
+        elsewhere) and a notice before kernels are compiled.
     retry_errors : bool
         Run again the runs stored as ``ERROR`` (their rows are replaced).
     batch_size : int, optional
@@ -292,13 +304,15 @@ def run_experiment(
     started: float | None = None,
     label: str | None = None,
     worker_wait_s: float = DEFAULT_WORKER_WAIT_S,
+    unit: str = "runs",
 ) -> SweepSummary:
     """Run (or resume) a validated :class:`Experiment` into a result database.
 
     The engine behind :func:`run_bench` and the presets ``pathfuse paper`` and
     ``pathfuse dynamic``; the arguments are those of :func:`run_bench`
     (``db_path`` may also be an open :class:`ResultStore`, left open; ``label``
-    names the progress bar, default the experiment's name).
+    names the progress bar, default the experiment's name; ``unit`` names what it
+    counts).
     """
     t0 = time.perf_counter() if started is None else started
     _check_counts(workers, batch_size)
@@ -317,14 +331,14 @@ def run_experiment(
                                                                              check=False)
         return _run_locked(exp, runs, store, own_store, nworkers, scheduler, progress,
                            retry_errors, batch_size, stream, on_start, t0, label,
-                           worker_wait_s)
+                           worker_wait_s, unit)
 
 
 def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_store: bool,
                 nworkers: int, scheduler: Any, progress: bool | None, retry_errors: bool,
                 batch_size: int | None, stream: Any,
                 on_start: Callable[[int, int], None] | None, t0: float,
-                label: str | None, worker_wait_s: float) -> SweepSummary:
+                label: str | None, worker_wait_s: float, unit: str) -> SweepSummary:
     experiment_path = exp.path
     summary = SweepSummary(experiment=exp.name, db_path=str(store.path), total=len(runs),
                            workers=nworkers,
@@ -333,6 +347,9 @@ def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_st
         done = store.done_keys(include_errors=not retry_errors)
         todo = [r for r in runs if r.key not in done]
         summary.skipped = len(runs) - len(todo)
+        if not retry_errors and summary.skipped:
+            errs = done - store.done_keys(include_errors=False)
+            summary.stored_errors = sum(1 for r in runs if r.key in errs)
         if on_start is not None:
             on_start(len(runs), len(todo))
         import hashlib
@@ -342,13 +359,17 @@ def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_st
             experiment_sha256=hashlib.sha256(exp.text.encode("utf-8")).hexdigest()[:16],
             experiment_text=exp.text, workers=nworkers, scheduler=summary.scheduler,
             planned=len(runs), skipped=summary.skipped)
-        enabled = bool(progress) if progress is not None else bool(
-            getattr(stream or sys.stderr, "isatty", lambda: False)())
+        enabled = progress_enabled(progress)
         bar = ProgressBar(len(runs), label=label or exp.name, stream=stream, enabled=enabled and
-                          bool(todo), initial=summary.skipped)
+                          bool(todo), initial=summary.skipped, unit=unit)
         sink = _Sink(store, exp, runs, summary, bar)
         state = "failed"
         try:
+            if todo and scheduler is None:  # compile once here; workers load from the cache
+                warm_kernels([r.planner for r in todo], metrics=True,
+                             world=any(r.kind == "dynamic" for r in todo),
+                             notify=bar.notice if enabled else None)
+                bar.start()
             if not todo:
                 pass
             elif scheduler is not None:

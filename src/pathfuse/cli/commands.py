@@ -77,7 +77,11 @@ def cmd_scen(args: argparse.Namespace) -> int:
     n_ok = n_bad = 0
     total_t = 0.0
     worst: list[str] = []
-    for p in problems:
+    _warm_with_notice("astar")
+    bar = _progress(len(problems), Path(args.scen).name, "lines", args)
+    for i, p in enumerate(problems):
+        if i and not i % 64:
+            bar.update(64)
         r = pathfuse.plan(grid, p.start, p.goal, planner="astar", heuristic=args.heuristic)
         total_t += r.time_s
         ok = r.success and abs(r.length - p.optimal_length) <= args.tol * max(1.0, p.optimal_length)
@@ -90,6 +94,8 @@ def cmd_scen(args: argparse.Namespace) -> int:
                     f"  line {p.line}: expected {p.optimal_length:.8f}, got "
                     f"{r.length:.8f} ({r.status.name})"
                 )
+    bar.update(len(problems) - bar.done)
+    bar.close()
     n = n_ok + n_bad
     print(f"{Path(args.scen).name}: {n_ok}/{n} lines match the optimal length "
           f"(rel. tol {args.tol:g}); A* time {total_t:.3f} s, "
@@ -99,16 +105,23 @@ def cmd_scen(args: argparse.Namespace) -> int:
     return 0 if n_bad == 0 else EXIT_FAIL
 
 
-def _warm_with_notice(planner: str) -> None:
-    """Compile the planner's kernels now, saying so first when numba's cache is cold."""
-    from pathfuse.planners.registry import get_planner
-    from pathfuse.planners.run import warm
+def _progress(total: int, label: str, unit: str, args: argparse.Namespace) -> Any:
+    """The progress display of a command (off with --quiet)."""
+    from pathfuse.bench.progress import ProgressBar
 
-    def notice() -> None:
-        print("pathfuse: compiling planner kernels (first run only; cached afterwards)",
-              file=sys.stderr, flush=True)
+    return ProgressBar(total, label=label, unit=unit,
+                       enabled=not getattr(args, "quiet", False))
 
-    warm(get_planner(planner), notify=notice)
+
+def _warm_with_notice(planner: str, world: bool = False) -> None:
+    """Compile the planner's kernels (and the world's) now, saying so first when numba's
+    cache is cold."""
+    from pathfuse.bench.warmup import warm_kernels
+
+    def notice(text: str) -> None:
+        print(f"pathfuse: {text}", file=sys.stderr, flush=True)
+
+    warm_kernels([planner], metrics=False, world=world, notify=notice)
 
 
 def planner_table() -> dict[str, Any]:
@@ -184,8 +197,6 @@ def cmd_paper(args: argparse.Namespace) -> int:
             f"--seed {cfg.figure_seed} is not among the maps run "
             f"({cfg.first_seed}..{cfg.first_seed + cfg.n_seeds - 1})"
         )
-    for name in cfg.planners:
-        _warm_with_notice(name)
     run = run_paper(cfg, progress=False if args.quiet else None, workers=args.workers,
                     db_path=_study_db(args.out))
     files = write_paper_outputs(run, args.out)
@@ -225,6 +236,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                   "params": {**dict(sc.planner.params), **params}}
     else:
         choice = {"name": args.planner, "params": params}
+    _warm_with_notice(choice["name"], world=True)
     ep = simulate(sc, planner=choice, seed=args.seed)
     anim = None
     if out is not None:
@@ -278,8 +290,6 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
         planners=parse_planner_list(args.planners), seed=args.seed,
         params=parse_planner_params(args.param),
     )
-    for name in cfg.planners:
-        _warm_with_notice(name)
     run = run_dynamic(cfg, progress=False if args.quiet else None, workers=args.workers,
                       db_path=_study_db(args.out))
     files = write_dynamic_outputs(run, args.out)

@@ -96,6 +96,9 @@ example:
     s.add_argument("--heuristic", default="octile", choices=["octile", "euclidean"],
                    help="A* heuristic (default octile; both are exact)")
     s.add_argument("--tol", type=_float, default=1e-6, help="relative tolerance (default 1e-6)")
+    s.add_argument("--quiet", action="store_true",
+                   help="no progress display (default on stderr: a live bar on a terminal, a "
+                   "few plain lines otherwise)")
     s.set_defaults(func=cmd_scen)
 
     pp = sub.add_parser(
@@ -125,7 +128,8 @@ examples:
                     help="output folder (default paper-out); its study.db keeps every run, "
                     "so running the same command again resumes or reuses them")
     pp.add_argument("--quiet", action="store_true",
-                    help="no progress bar (default: a bar on stderr when it is a terminal)")
+                    help="no progress display (default on stderr: a live bar on a terminal, a "
+                    "few plain lines otherwise)")
     pp.set_defaults(func=cmd_paper)
 
     sm = sub.add_parser(
@@ -206,7 +210,8 @@ examples:
                     help="output folder (default dynamic-out); its study.db keeps every "
                     "episode, so running the same command again resumes or reuses them")
     dy.add_argument("--quiet", action="store_true",
-                    help="no progress bar (default: a bar on stderr when it is a terminal)")
+                    help="no progress display (default on stderr: a live bar on a terminal, a "
+                    "few plain lines otherwise)")
     dy.set_defaults(func=cmd_dynamic)
 
     b = sub.add_parser(
@@ -250,7 +255,8 @@ See experiments/*.yaml for the file format (maps, seeds, planners, swept paramet
     b.add_argument("--retry-errors", action="store_true",
                    help="run again the runs stored as ERROR")
     b.add_argument("--no-progress", action="store_true",
-                   help="no progress bar (default: a bar on stderr when it is a terminal)")
+                   help="no progress display (default on stderr: a live bar on a terminal, a "
+                   "few plain lines otherwise)")
     b.set_defaults(func=cmd_bench)
 
     r = sub.add_parser(

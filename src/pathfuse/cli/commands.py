@@ -236,7 +236,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                   "params": {**dict(sc.planner.params), **params}}
     else:
         choice = {"name": args.planner, "params": params}
-    _warm_with_notice(choice["name"], world=True)
+    _warm_with_notice(str(choice["name"]), world=True)
     ep = simulate(sc, planner=choice, seed=args.seed)
     anim = None
     if out is not None:

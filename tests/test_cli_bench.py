@@ -106,7 +106,10 @@ def test_bench_resume_and_report(tmp_path):
     again = run("bench", "tiny.yaml", "--db", db, "--workers", "1", "--no-progress",
                 cwd=tmp_path)
     assert again.returncode == 0, again.stderr
-    assert "tiny: 0 runs in" in again.stdout and "9 already stored; 9/9" in again.stdout
+    # said as such, not as "0 runs ... solved 0, not solved 0", which reads as an empty study
+    assert again.stdout.splitlines() == [
+        f"tiny: nothing to run, all 9 runs are already stored in {db} ('pathfuse report "
+        f"{db}' summarises them)"]
     con = sqlite3.connect(db)
     assert con.execute("SELECT id, run_key, solution_length FROM runs ORDER BY id") \
         .fetchall() == keys
@@ -147,7 +150,8 @@ planners:
     assert count(db) == 4 and count(db, "status_name = 'ERROR' AND seed = 2") == 1
     # plain re-run: the stored error is not retried; --retry-errors runs it again
     p = run("bench", "e.yaml", "--db", db, "--workers", "1", "--no-progress", cwd=tmp_path)
-    assert p.returncode == 0 and "4 already stored" in p.stdout
+    assert p.returncode == 0 and "all 4 runs are already stored" in p.stdout
+    assert "1 of them raised (ERROR), --retry-errors runs them again" in p.stdout
     p = run("bench", "e.yaml", "--db", db, "--workers", "1", "--no-progress",
             "--retry-errors", cwd=tmp_path)
     assert p.returncode == 1 and "1 runs in" in p.stdout and "3 already stored" in p.stdout

@@ -92,3 +92,201 @@ def test_unreachable_scheduler_is_a_config_error(tmp_path):
     exp = _study(tmp_path)
     with pytest.raises(ConfigError, match=f"scheduler: cannot connect to tcp://127.0.0.1:{port}"):
         run_bench(exp, tmp_path / "y.db", scheduler=f"tcp://127.0.0.1:{port}", progress=False)
+
+
+# ---------------------------------------------------------------- a cluster that goes away
+SEGMENT = '''
+from dataclasses import dataclass
+import time
+import numpy as np
+from pathfuse.planners.registry import register_function
+from pathfuse.result import PlanResult, Status
+
+
+@dataclass(frozen=True)
+class Params:
+    seed: int = 0
+    sleep_s: float = 0.0
+
+
+def plan(grid, start, goal, params, budget):
+    time.sleep(params.sleep_s)
+    path = np.array([start, goal], dtype=float)
+    return PlanResult(Status.SUCCESS, path=path, length=float(np.hypot(*(goal - start))),
+                      time_s=params.sleep_s)
+
+
+register_function("segment", plan, Params, "straight segment (test plug-in)")
+'''
+
+SLOW = """imports: [seg.py]
+seeds: 200
+maps:
+  - name: room
+    map: {rows: ["......", "......"]}
+    start: [0.5, 0.5]
+    goal: [5.5, 1.5]
+planners:
+  - name: segment
+    params: {sleep_s: 0.03}
+"""
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _stored(db, where="1"):
+    import sqlite3
+
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=5) as c:
+            return int(c.execute(f"SELECT COUNT(*) FROM runs WHERE {where}").fetchone()[0])
+    except sqlite3.Error:
+        return 0
+
+
+class _Cluster:
+    """A real scheduler and one worker, each a process group of its own, killable."""
+
+    def __init__(self, tmp_path):
+        import socket
+        import subprocess
+        import time
+
+        self.port = _free_port()
+        self.address = f"tcp://127.0.0.1:{self.port}"
+        log = open(tmp_path / "cluster.log", "w")  # noqa: SIM115 - closed in stop()
+        self.log = log
+        self.scheduler = subprocess.Popen(
+            [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+             "--port", str(self.port), "--no-dashboard"],
+            stdout=log, stderr=log, start_new_session=True)
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                socket.create_connection(("127.0.0.1", self.port), timeout=1).close()
+                break
+            except OSError:
+                assert time.monotonic() < deadline, "the scheduler did not start"
+                time.sleep(0.1)
+        self.worker = subprocess.Popen(
+            [sys.executable, "-m", "distributed.cli.dask_worker", self.address,
+             "--nworkers", "1", "--nthreads", "1", "--no-dashboard"],
+            stdout=log, stderr=log, start_new_session=True)
+        import distributed
+
+        with distributed.Client(self.address, timeout="30s", set_as_default=False) as c:
+            c.wait_for_workers(1, timeout=60)
+
+    def kill(self, proc) -> None:
+        import os
+        import signal
+
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        proc.wait(timeout=30)
+
+    def stop(self) -> None:
+        self.kill(self.worker)
+        self.kill(self.scheduler)
+        self.log.close()
+
+
+def _bench(tmp_path, *extra):
+    import subprocess
+
+    (tmp_path / "seg.py").write_text(SEGMENT)
+    (tmp_path / "slow.yaml").write_text(SLOW)
+    cmd = [sys.executable, "-m", "pathfuse.cli", "bench", "slow.yaml", "--db", "s.db",
+           "--batch-size", "2", *extra]
+    return subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True), cmd
+
+
+def _wait_stored(proc, db, n, timeout=120):
+    import time
+
+    deadline = time.monotonic() + timeout
+    while _stored(db) < n:
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, f"fewer than {n} runs after {timeout} s"
+        time.sleep(0.05)
+
+
+@pytest.mark.slow
+def test_a_lost_scheduler_stores_no_errors_and_the_same_command_resumes(tmp_path):
+    pytest.importorskip("distributed")
+    import subprocess
+    import time
+
+    cluster = _Cluster(tmp_path)
+    try:
+        proc, cmd = _bench(tmp_path, "--scheduler", cluster.address)
+        try:
+            _wait_stored(proc, tmp_path / "s.db", 10)
+            cluster.kill(cluster.scheduler)
+            t0 = time.monotonic()
+            out, err = proc.communicate(timeout=60)
+            took = time.monotonic() - t0
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    finally:
+        cluster.stop()
+    assert proc.returncode == 1, (out, err)
+    assert err.splitlines() == [
+        f"pathfuse bench: error: lost the Dask scheduler at {cluster.address} "
+        "(scheduler-connection-lost); the runs that finished are stored, run the same "
+        "command again to finish the rest"], err
+    assert took < 30, took
+    stored = _stored(tmp_path / "s.db")
+    assert 10 <= stored < 200
+    assert _stored(tmp_path / "s.db", "status_name = 'ERROR'") == 0
+    assert f"{stored}/200 in s.db" in out and "errors 0" in out
+    # the unfinished runs are missing, not failed: a resumed sweep runs exactly them
+    local = [a for a in cmd if a not in ("--scheduler", cluster.address)] + ["--workers", "2"]
+    again = subprocess.run(local, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert f"{200 - stored} runs" in again.stdout and f"{stored} already stored" in again.stdout
+    assert _stored(tmp_path / "s.db", "status_name = 'SUCCESS'") == 200
+
+
+@pytest.mark.slow
+def test_a_cluster_without_workers_says_so_and_stops(tmp_path):
+    pytest.importorskip("distributed")
+    import time
+
+    cluster = _Cluster(tmp_path)
+    try:
+        proc, _ = _bench(tmp_path, "--scheduler", cluster.address, "--worker-wait", "8")
+        try:
+            _wait_stored(proc, tmp_path / "s.db", 10)
+            cluster.kill(cluster.worker)  # the scheduler stays, with no worker
+            t0 = time.monotonic()
+            out, err = proc.communicate(timeout=90)
+            took = time.monotonic() - t0
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    finally:
+        cluster.stop()
+    assert proc.returncode == 1, (out, err)
+    assert "Traceback" not in err
+    assert err.splitlines() == [
+        f"pathfuse: no worker is connected to the Dask scheduler at {cluster.address}; "
+        "waiting up to 8 s for one (Ctrl-C stops, stored runs are kept)",
+        f"pathfuse bench: error: every worker of the Dask cluster at {cluster.address} is "
+        "gone (none for 8 s); the runs that finished are stored, start workers and run the "
+        "same command again to finish the rest"], err
+    assert 8 <= took < 40, took
+    assert _stored(tmp_path / "s.db", "status_name = 'ERROR'") == 0
+    assert 10 <= _stored(tmp_path / "s.db") < 200

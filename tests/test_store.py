@@ -137,9 +137,9 @@ def test_reopen_keeps_everything_and_sessions(tmp_path):
 def test_bad_databases_are_config_errors(tmp_path):
     junk = tmp_path / "junk.db"
     junk.write_bytes(b"this is not sqlite at all" * 100)
-    with pytest.raises(ConfigError, match="junk.db: not a usable result database"):
+    with pytest.raises(ConfigError, match="junk.db: not an SQLite database"):
         ResultStore(junk)
-    with pytest.raises(ConfigError, match="no such result database"):
+    with pytest.raises(ConfigError, match="no such study database"):
         ResultStore(tmp_path / "missing.db", readonly=True)
     with pytest.raises(ConfigError, match="does not exist"):
         ResultStore(tmp_path / "no" / "dir" / "x.db")

@@ -32,13 +32,21 @@ Examples
 """
 
 from pathfuse.bench.experiment import Experiment, RunSpec, load_experiment, parse_experiment
-from pathfuse.bench.runner import SweepInterrupted, SweepSummary, run_bench
+from pathfuse.bench.runner import (
+    ClusterLost,
+    StudyLocked,
+    SweepInterrupted,
+    SweepSummary,
+    run_bench,
+)
 from pathfuse.bench.store import WALL_CLOCK_COLUMNS, ResultStore, comparable_rows
 
 __all__ = [
     "run_bench",
     "SweepSummary",
     "SweepInterrupted",
+    "ClusterLost",
+    "StudyLocked",
     "Experiment",
     "RunSpec",
     "load_experiment",

@@ -24,15 +24,12 @@ from typing import Any, Protocol
 
 from pathfuse.bench.execute import execute_batch, execute_run
 from pathfuse.bench.experiment import (
-    FILE_FAMILIES,
     Experiment,
     RunSpec,
     iter_groups,
-    load_dynamic,
-    load_map,
 )
 from pathfuse.bench.plugins import ensure_imports
-from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.result import PathfuseError
 
 
 class Sink(Protocol):
@@ -130,8 +127,13 @@ def _run_serial(exp: Experiment, todo: Sequence[RunSpec], sink: Sink) -> None:
             sink.write(pending)
 
 
-def _worker_init(imports: Sequence[str]) -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the client handles Ctrl-C
+def _worker_init(imports: Sequence[str], client_pid: int | None = None) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the client handles Ctrl-C and SIGTERM;
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)  # it stops the workers itself
+    if client_pid is not None:  # die with the client, even after kill -9
+        from pathfuse.bench.lifeline import watch_client
+
+        watch_client(client_pid)
     ensure_imports(imports)
 
 
@@ -179,13 +181,16 @@ class _Pool:
 
     def __init__(self, workers: int, imports: Sequence[str]) -> None:
         self.ex = ProcessPoolExecutor(max_workers=workers, mp_context=_mp_context(),
-                                      initializer=_worker_init, initargs=(list(imports),))
+                                      initializer=_worker_init,
+                                      initargs=(list(imports), os.getpid()))
         try:
             pings = [self.ex.submit(_ping) for _ in range(workers)]
             for f in pings:
                 f.result(timeout=300)
-        except BrokenProcessPool:
+        except BaseException as exc:  # Ctrl-C/SIGTERM while starting: stop the workers
             self.kill()
+            if not isinstance(exc, BrokenProcessPool):
+                raise
             raise WorkersCannotStart(
                 "the worker processes die as they start (see the errors above); run with "
                 "workers=1 to see the problem in this process") from None
@@ -201,9 +206,9 @@ class _Pool:
     def kill(self) -> None:
         procs = list(getattr(self.ex, "_processes", {}).values())
         self.ex.shutdown(wait=False, cancel_futures=True)
-        for p in procs:  # only the workers this pool started
+        for p in procs:  # only the workers this pool started (they ignore SIGTERM)
             if p.is_alive():
-                p.terminate()
+                p.kill()
         for p in procs:
             p.join(timeout=5)
 
@@ -266,106 +271,3 @@ def _isolate(exp: Experiment, runs: Sequence[RunSpec], sink: Sink,
             sink.write(rows)
     finally:
         pool.kill()
-
-
-def _connect_dask(scheduler: Any) -> tuple[Any, bool]:
-    try:
-        import distributed  # type: ignore[import-not-found]
-    except ImportError:
-        raise ConfigError("scheduler: Dask distributed is not installed; install it with "
-                          "pip install 'pathfuse[dask]'") from None
-    if isinstance(scheduler, distributed.Client):
-        return scheduler, False
-    if not isinstance(scheduler, str) or "://" not in scheduler:
-        raise ConfigError(f"scheduler: expected an address like tcp://HOST:8786, "
-                          f"got {scheduler!r}")
-    _probe(scheduler)
-    try:
-        return distributed.Client(scheduler, timeout="20s", set_as_default=False), True
-    except (OSError, TimeoutError) as exc:
-        raise ConfigError(f"scheduler: cannot connect to {scheduler} ({exc})") from None
-
-
-def _probe(address: str, timeout_s: float = 5.0) -> None:
-    """Fail fast when nothing listens at a ``tcp://HOST:PORT`` address."""
-    import socket
-    from urllib.parse import urlsplit
-
-    u = urlsplit(address)
-    if u.scheme != "tcp" or u.port is None:
-        return
-    try:
-        with socket.create_connection((u.hostname or "127.0.0.1", u.port), timeout=timeout_s):
-            pass
-    except OSError as exc:
-        raise ConfigError(f"scheduler: cannot connect to {address} ({exc.strerror or exc}); "
-                          "is 'dask scheduler' running there?") from None
-
-
-def _run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: Sink, scheduler: Any,
-              batch_size: int | None) -> int:
-    from distributed import as_completed  # type: ignore[import-not-found]
-    from distributed.scheduler import KilledWorker  # type: ignore[import-not-found]
-
-    client, own = _connect_dask(scheduler)
-    futures: list[Any] = []
-    try:
-        nworkers = max(1, sum(w.get("nthreads", 1) for w in
-                              client.scheduler_info().get("workers", {}).values()))
-        for imp in exp.import_paths():
-            if imp.endswith(".py"):
-                client.upload_file(imp)
-        # maps read from files are loaded here once and shipped; generated maps are
-        # made on the workers from their spec
-        grids: dict[str, Any] = {}
-        for r in todo:
-            if r.map_key in grids or not r.map_spec:
-                continue
-            if r.kind == "static" and any(f in r.map_spec for f in FILE_FAMILIES):
-                grids[r.map_key] = client.scatter(load_map(r.map_spec, exp.base_dir),
-                                                  broadcast=False, hash=True)
-            elif r.kind == "dynamic" and isinstance(r.map_spec.get("dynamic"), str):
-                grids[r.map_key] = client.scatter(load_dynamic(r.map_spec),
-                                                  broadcast=False, hash=True)
-        index: dict[Any, list[list[RunSpec]]] = {}
-        for b in make_batches(todo, nworkers, batch_size):
-            f = client.submit(execute_batch, _batch_payload(exp, b, grids), pure=False)
-            index[f] = b
-            futures.append(f)
-        singles: list[RunSpec] = []
-        for f in as_completed(futures, loop=client.loop):
-            b = index.pop(f)
-            try:
-                sink.write(f.result())
-            except KilledWorker:
-                singles.extend(r for c in b for r in c)
-            except Exception as exc:  # noqa: BLE001 - stored as the runs' error
-                sink.write(_exception_rows(b, exc))
-        # batches that killed workers: one run per task, so only the culprit fails
-        if singles:
-            single_index: dict[Any, RunSpec] = {}
-            fs = []
-            for r in singles:
-                f = client.submit(execute_batch, _batch_payload(exp, [[r]], grids),
-                                  pure=False)
-                single_index[f] = r
-                fs.append(f)
-            futures.extend(fs)
-            for f in as_completed(fs, loop=client.loop):
-                r = single_index.pop(f)
-                try:
-                    sink.write(f.result())
-                except KilledWorker:
-                    sink.write([_crash_row(r)])
-                except Exception as exc:  # noqa: BLE001
-                    sink.write(_exception_rows([[r]], exc))
-        return nworkers
-    finally:
-        try:
-            client.cancel(futures)
-        except Exception:  # noqa: BLE001 - the cluster may be gone
-            pass
-        if own:
-            client.close()
-
-

@@ -1,11 +1,18 @@
-"""A tiny progress bar for sweeps (stderr; no third-party dependency).
+"""The one progress display of pathfuse (``bench``, ``paper``, ``dynamic``, ``scen``), on stderr.
 
 On a terminal it redraws one line in place::
 
     fusion-sweep [##########----------]  512/1024  50%  41.3 runs/s  ETA 0:00:12  3 err
 
-Elsewhere (a log file, CI) it prints a plain line at most every
-``interval_s`` seconds and at the end, so logs stay short.
+Elsewhere (a log file, CI, a pipe) it writes a few plain lines: one every
+``interval_s`` seconds (30 by default) and a last one, so logs stay short.
+
+The rate and the time left are measured from the first finished item on,
+so starting the workers (and loading kernels) does not make the first
+estimate absurd; until two updates have come in, the line says
+``starting`` instead of a rate.  The last line gives that rate and the
+whole elapsed time (start-up included).
+``unit`` names what is counted (runs, episodes, lines).
 
 Examples
 --------
@@ -26,7 +33,7 @@ import sys
 import time
 from typing import IO
 
-__all__ = ["ProgressBar", "format_duration"]
+__all__ = ["ProgressBar", "format_duration", "progress_enabled"]
 
 
 def format_duration(seconds: float) -> str:
@@ -41,88 +48,136 @@ def format_duration(seconds: float) -> str:
     return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
 
 
+def progress_enabled(progress: bool | None) -> bool:
+    """``progress`` of the library calls: False shows nothing; True or None show the
+    display (a live bar on a terminal, a few plain lines elsewhere)."""
+    return progress is not False
+
+
 class ProgressBar:
-    """Runs done / total, rate, time left.
+    """Items done / total, rate, time left.
 
     Parameters
     ----------
     total : int
-        Runs to do in this session.
+        Items of the whole task (those done before this session included).
     label : str
         Shown first on the line.
     stream : file, optional
         Default ``sys.stderr``.
     enabled : bool
-        When False, nothing is written.
+        When False, nothing is written but :meth:`notice` lines.
     tty : bool, optional
         Redraw in place; default: whether ``stream`` is a terminal.
-    interval_s : float
-        Minimum time between two writes (the final line is always written).
+    interval_s : float, optional
+        Minimum time between two writes (default 0.1 s on a terminal, 30 s
+        otherwise); the last line is always written.
     width : int
         Characters of the bar itself.
     initial : int
-        Runs already done before this session (a resumed sweep): counted in
+        Items already done before this session (a resumed sweep): counted in
         ``done / total`` but not in the rate.
+    unit : str
+        What is counted, plural (``runs``, ``episodes``, ``lines``).
     """
 
     def __init__(self, total: int, label: str = "", stream: IO[str] | None = None,
                  enabled: bool = True, tty: bool | None = None, interval_s: float | None = None,
-                 width: int = 24, initial: int = 0) -> None:
+                 width: int = 24, initial: int = 0, unit: str = "runs") -> None:
         self.total = max(0, int(total))
         self.initial = max(0, int(initial))
         self.label = label
+        self.unit = unit
         self.stream = stream if stream is not None else sys.stderr
         self.enabled = enabled
         if tty is None:
             isatty = getattr(self.stream, "isatty", None)
             tty = bool(isatty and isatty())
         self.tty = tty
-        self.interval_s = (0.1 if tty else 10.0) if interval_s is None else interval_s
+        self.interval_s = (0.1 if tty else 30.0) if interval_s is None else interval_s
         self.width = width
         self.done = self.initial
         self.errors = 0
         self.t0 = time.perf_counter()
-        self._last = -1e9
+        self._first: tuple[float, int] | None = None  # (time, done) at the first update
+        self._updates = 0
+        self._last = time.perf_counter() if not tty else -1e9
         self._closed = False
+        if self.enabled and self.tty:
+            self._write(time.perf_counter(), force=True)
+
+    def start(self) -> None:
+        """Restart the clock (after a set-up phase that should not count)."""
+        self.t0 = time.perf_counter()
+        if self.enabled and self.tty:
+            self._write(self.t0, force=True)
 
     def update(self, n: int = 1, errors: int = 0) -> None:
-        """Count ``n`` more finished runs (``errors`` of them raised)."""
+        """Count ``n`` more finished items (``errors`` of them raised)."""
+        now = time.perf_counter()
+        if self._first is None:
+            self._first = (now, self.done)
         self.done += n
         self.errors += errors
-        now = time.perf_counter()
+        self._updates += 1
         if now - self._last >= self.interval_s:
             self._write(now)
 
-    def line(self, now: float | None = None) -> str:
+    def rate(self, now: float) -> float | None:
+        """Items per second since the first finished one (None until known)."""
+        if self._first is None or self._updates < 2:
+            return None
+        t1, d1 = self._first
+        if now - t1 <= 0:
+            return None
+        return (self.done - d1) / (now - t1)
+
+    def line(self, now: float | None = None, final: bool = False) -> str:
         """The current status line."""
         now = time.perf_counter() if now is None else now
-        el = max(now - self.t0, 1e-9)
-        rate = (self.done - self.initial) / el
-        left = (self.total - self.done) / rate if rate > 0 else float("inf")
         frac = self.done / self.total if self.total else 1.0
         fill = int(round(frac * self.width))
         bar = "#" * fill + "-" * (self.width - fill)
         w = len(str(self.total))
         err = f"  {self.errors} err" if self.errors else ""
-        return (f"{self.label} [{bar}] {self.done:>{w}}/{self.total} {100 * frac:3.0f}%  "
-                f"{rate:.1f} runs/s  ETA {format_duration(left)}{err}").lstrip()
+        rate = self.rate(now)
+        if final:
+            ran, el = self.done - self.initial, now - self.t0
+            rate = rate if rate is not None else (ran / el if ran and el > 0 else None)
+            per = f"  {rate:.1f} {self.unit}/s" if rate else ""
+            tail = f"{per}  in {format_duration(now - self.t0)}"
+        elif rate is None:
+            tail = "  starting"
+        else:
+            left = (self.total - self.done) / rate if rate > 0 else float("inf")
+            tail = f"  {rate:.1f} {self.unit}/s  ETA {format_duration(left)}"
+        return (f"{self.label} [{bar}] {self.done:>{w}}/{self.total} {100 * frac:3.0f}%"
+                f"{tail}{err}").lstrip()
 
-    def _write(self, now: float) -> None:
+    def _write(self, now: float, force: bool = False, final: bool = False) -> None:
         if not self.enabled or self._closed:
             return
         self._last = now
-        text = self.line(now)
+        text = self.line(now, final=final)
         if self.tty:
             self.stream.write("\r" + text + "\x1b[K")
         else:
             self.stream.write(text + "\n")
         self.stream.flush()
 
+    def notice(self, text: str) -> None:
+        """Write one line (``pathfuse: TEXT``) above the bar, even when the bar is off."""
+        live = self.tty and self.enabled and not self._closed
+        self.stream.write(("\r\x1b[K" if live else "") + f"pathfuse: {text}\n")
+        if live:
+            self.stream.write(self.line() + "\x1b[K")
+        self.stream.flush()
+
     def close(self) -> None:
-        """Write the final line (and end it with a newline on a terminal)."""
+        """Write the last line (and end it with a newline on a terminal)."""
         if self._closed:
             return
-        self._write(time.perf_counter())
+        self._write(time.perf_counter(), final=True)
         if self.enabled and self.tty:
             self.stream.write("\n")
             self.stream.flush()

@@ -24,32 +24,34 @@ complete.
 from __future__ import annotations
 
 import os
-import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from pathfuse.bench.dask_backend import DEFAULT_WORKER_WAIT_S, ClusterLost, run_dask
 from pathfuse.bench.experiment import (
     Experiment,
     RunSpec,
     canonical_json,
     load_experiment,
 )
+from pathfuse.bench.lock import StudyLocked, study_lock
 from pathfuse.bench.pool import (
     WorkersCannotStart,
     _main_without_file,
-    _run_dask,
     _run_pool,
     _run_serial,
     make_batches,
 )
-from pathfuse.bench.progress import ProgressBar
+from pathfuse.bench.progress import ProgressBar, progress_enabled
 from pathfuse.bench.store import ResultStore
+from pathfuse.bench.warmup import warm_kernels
 from pathfuse.result import ConfigError
 
-__all__ = ["run_bench", "run_experiment", "SweepSummary", "SweepInterrupted",
+__all__ = ["run_bench", "run_experiment", "SweepSummary", "SweepInterrupted", "StudyLocked",
+           "ClusterLost",
            "WorkersCannotStart", "make_batches", "default_workers"]
 
 CRASH_TEXT = ("WorkerCrashed: the worker process died while running this run "
@@ -74,6 +76,8 @@ class SweepSummary:
     workers: int = 1
     scheduler: str | None = None
     error_samples: list[str] = field(default_factory=list)
+    stored_errors: int = 0
+    """Runs skipped because they are stored as ``ERROR`` (``retry_errors`` runs them)."""
 
     @property
     def runs_per_s(self) -> float:
@@ -92,10 +96,18 @@ class SweepSummary:
 
     def __str__(self) -> str:
         where = self.scheduler or (f"{self.workers} worker" + ("s" if self.workers > 1 else ""))
+        stored = self.skipped + self.ran
+        if self.ran == 0 and self.complete and not self.interrupted:
+            errs = (f"; {self.stored_errors} of them raised (ERROR), --retry-errors runs "
+                    "them again") if self.stored_errors else ""
+            return (f"{self.experiment}: nothing to run, all {self.total} runs are already "
+                    f"stored in {self.db_path} ('pathfuse report {self.db_path}' summarises "
+                    f"them){errs}")
         head = (f"{self.experiment}: {self.ran} runs in {self.wall_s:.1f} s "
                 f"({self.runs_per_s:.1f} runs/s, {where}); {self.skipped} already stored; "
-                f"{self.skipped + self.ran}/{self.total} in {self.db_path}")
-        tail = f"\n  solved {self.succeeded}, not solved {self.failed}, errors {self.errors}"
+                f"{stored}/{self.total} in {self.db_path}")
+        tail = (f"\n  of the {self.ran} run now: solved {self.succeeded}, not solved "
+                f"{self.failed}, errors {self.errors}")
         if self.crashed:
             tail += f" ({self.crashed} crashed their worker)"
         if self.interrupted:
@@ -108,9 +120,12 @@ class SweepSummary:
 class SweepInterrupted(KeyboardInterrupt):
     """Ctrl-C during a sweep; ``.summary`` holds what was stored before it."""
 
-    def __init__(self, summary: SweepSummary) -> None:
+    def __init__(self, summary: SweepSummary, signame: str = "") -> None:
         super().__init__(str(summary))
         self.summary = summary
+        self.signame = signame
+        """``"SIGTERM"`` when a SIGTERM (made a :class:`~pathfuse.bench.lifeline.Terminated`)
+        stopped the sweep, ``""`` for Ctrl-C."""
 
 
 def default_workers() -> int:
@@ -150,6 +165,10 @@ class _Sink:
                 if k not in self.cfg_ids:
                     self.cfg_ids[k] = store.ensure_planner_config(r.config, r.planner,
                                                                   r.settings)
+
+    def notice(self, text: str) -> None:
+        """One line on the progress bar's stream (the cluster lost its workers, ...)."""
+        self.bar.notice(text)
 
     def complete(self, row: dict[str, Any]) -> dict[str, Any]:
         r = self.specs[row["run_key"]]
@@ -203,6 +222,7 @@ def run_bench(
     batch_size: int | None = None,
     stream: Any = None,
     on_start: Callable[[int, int], None] | None = None,
+    worker_wait_s: float = DEFAULT_WORKER_WAIT_S,
 ) -> SweepSummary:
     """Run (or resume) the sweep of an experiment file into a result database.
 
@@ -220,7 +240,9 @@ def run_bench(
         ``"tcp://HOST:PORT"`` of a Dask scheduler (or a ``distributed.Client``);
         ``workers`` is then ignored.
     progress : bool or None
-        Show a progress bar on stderr (None: only when stderr is a terminal).
+        False shows nothing; True or None show the progress display on ``stream``
+        (:mod:`pathfuse.bench.progress`: a live bar on a terminal, a few plain lines
+        elsewhere) and a notice before kernels are compiled.
     retry_errors : bool
         Run again the runs stored as ``ERROR`` (their rows are replaced).
     batch_size : int, optional
@@ -229,6 +251,9 @@ def run_bench(
         Where the progress bar writes (default ``sys.stderr``).
     on_start : callable, optional
         Called with ``(total, to_run)`` once the run list is known.
+    worker_wait_s : float
+        With ``scheduler``: how long to wait when the cluster has no worker left
+        before giving up with :class:`ClusterLost` (it says so after 5 s).
 
     Returns
     -------
@@ -240,14 +265,20 @@ def run_bench(
         A bad experiment file, ``workers``, ``scheduler`` or database (one line
         naming the key).
     SweepInterrupted
-        Ctrl-C; everything finished before it is stored.
+        Ctrl-C (or SIGTERM, see :mod:`pathfuse.bench.lifeline`); everything finished
+        before it is stored.
+    ClusterLost
+        The Dask scheduler was lost, or no worker was left for ``worker_wait_s``; the
+        runs that finished are stored, the others stay missing (the same call resumes).
+    StudyLocked
+        Another sweep is writing the same database (:mod:`pathfuse.bench.lock`).
     """
     t0 = time.perf_counter()
     _check_counts(workers, batch_size)
     exp = load_experiment(experiment_path, seeds=seeds)
     return run_experiment(exp, db_path, workers, scheduler, progress,
                           retry_errors=retry_errors, batch_size=batch_size, stream=stream,
-                          on_start=on_start, started=t0)
+                          on_start=on_start, started=t0, worker_wait_s=worker_wait_s)
 
 
 def _check_counts(workers: Any, batch_size: Any) -> None:
@@ -272,23 +303,43 @@ def run_experiment(
     on_start: Callable[[int, int], None] | None = None,
     started: float | None = None,
     label: str | None = None,
+    worker_wait_s: float = DEFAULT_WORKER_WAIT_S,
+    unit: str = "runs",
 ) -> SweepSummary:
     """Run (or resume) a validated :class:`Experiment` into a result database.
 
     The engine behind :func:`run_bench` and the presets ``pathfuse paper`` and
     ``pathfuse dynamic``; the arguments are those of :func:`run_bench`
     (``db_path`` may also be an open :class:`ResultStore`, left open; ``label``
-    names the progress bar, default the experiment's name).
+    names the progress bar, default the experiment's name; ``unit`` names what it
+    counts).
     """
     t0 = time.perf_counter() if started is None else started
     _check_counts(workers, batch_size)
-    experiment_path = exp.path
     runs = exp.expand()
     nworkers = default_workers() if workers is None else workers
     if scheduler is not None:
         _connect_check(scheduler)
     own_store = not isinstance(db_path, ResultStore)
-    store = db_path if isinstance(db_path, ResultStore) else ResultStore(db_path)
+    # one sweep at a time per database: a second one is refused before it opens the store
+    if not isinstance(db_path, ResultStore) and str(db_path) != ":memory:":
+        from pathfuse.bench.dbcheck import check_study_file
+
+        check_study_file(db_path, write=True)  # a folder, damaged, foreign, read-only
+    with study_lock(db_path.path if isinstance(db_path, ResultStore) else db_path):
+        store = db_path if isinstance(db_path, ResultStore) else ResultStore(db_path,
+                                                                             check=False)
+        return _run_locked(exp, runs, store, own_store, nworkers, scheduler, progress,
+                           retry_errors, batch_size, stream, on_start, t0, label,
+                           worker_wait_s, unit)
+
+
+def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_store: bool,
+                nworkers: int, scheduler: Any, progress: bool | None, retry_errors: bool,
+                batch_size: int | None, stream: Any,
+                on_start: Callable[[int, int], None] | None, t0: float,
+                label: str | None, worker_wait_s: float, unit: str) -> SweepSummary:
+    experiment_path = exp.path
     summary = SweepSummary(experiment=exp.name, db_path=str(store.path), total=len(runs),
                            workers=nworkers,
                            scheduler=_scheduler_name(scheduler))
@@ -296,6 +347,9 @@ def run_experiment(
         done = store.done_keys(include_errors=not retry_errors)
         todo = [r for r in runs if r.key not in done]
         summary.skipped = len(runs) - len(todo)
+        if not retry_errors and summary.skipped:
+            errs = done - store.done_keys(include_errors=False)
+            summary.stored_errors = sum(1 for r in runs if r.key in errs)
         if on_start is not None:
             on_start(len(runs), len(todo))
         import hashlib
@@ -305,28 +359,38 @@ def run_experiment(
             experiment_sha256=hashlib.sha256(exp.text.encode("utf-8")).hexdigest()[:16],
             experiment_text=exp.text, workers=nworkers, scheduler=summary.scheduler,
             planned=len(runs), skipped=summary.skipped)
-        enabled = bool(progress) if progress is not None else bool(
-            getattr(stream or sys.stderr, "isatty", lambda: False)())
+        enabled = progress_enabled(progress)
         bar = ProgressBar(len(runs), label=label or exp.name, stream=stream, enabled=enabled and
-                          bool(todo), initial=summary.skipped)
+                          bool(todo), initial=summary.skipped, unit=unit)
         sink = _Sink(store, exp, runs, summary, bar)
         state = "failed"
         try:
+            if todo and scheduler is None:  # compile once here; workers load from the cache
+                warm_kernels([r.planner for r in todo], metrics=True,
+                             world=any(r.kind == "dynamic" for r in todo),
+                             notify=bar.notice if enabled else None)
+                bar.start()
             if not todo:
                 pass
             elif scheduler is not None:
-                summary.workers = _run_dask(exp, todo, sink, scheduler, batch_size)
+                summary.workers = run_dask(exp, todo, sink, scheduler, batch_size,
+                                           worker_wait_s)
             elif nworkers == 1 or len(todo) == 1:
                 _run_serial(exp, todo, sink)
             else:
                 with _main_without_file():
                     _run_pool(exp, todo, sink, nworkers, batch_size)
             state = "finished"
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as exc:
             state = "interrupted"
             summary.interrupted = True
             summary.wall_s = time.perf_counter() - t0
-            raise SweepInterrupted(summary) from None
+            raise SweepInterrupted(summary, getattr(exc, "signame", "")) from None
+        except ClusterLost as exc:
+            state = "cluster-lost"
+            summary.interrupted = True
+            exc.summary = summary
+            raise
         finally:
             bar.close()
             summary.wall_s = time.perf_counter() - t0

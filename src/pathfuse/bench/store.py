@@ -259,24 +259,30 @@ class ResultStore:
         The SQLite file (``":memory:"`` for tests).
     readonly : bool
         Open an existing database for reading only.
+    check : bool
+        Check the file first (:func:`~pathfuse.bench.dbcheck.check_study_file`); False
+        when the caller just did.
 
     Raises
     ------
     ConfigError
-        The file is not a SQLite database, or was written by a newer schema.
+        The file is a folder, not SQLite, another application's database, damaged
+        (SQLite's ``quick_check``), read-only when opened for writing, or written by
+        a newer schema (:func:`~pathfuse.bench.dbcheck.check_study_file`; the
+        file is not touched before these checks).
     """
 
-    def __init__(self, path: str | os.PathLike[str], readonly: bool = False) -> None:
+    def __init__(self, path: str | os.PathLike[str], readonly: bool = False, *,
+                 check: bool = True) -> None:
         self.path = str(path)
+        if self.path != ":memory:" and check:
+            from pathfuse.bench.dbcheck import check_study_file
+
+            check_study_file(self.path, write=not readonly)  # only reads the file
         if readonly:
-            if not Path(self.path).is_file():
-                raise ConfigError(f"{self.path}: no such result database")
             uri = Path(self.path).resolve().as_uri() + "?mode=ro"
             self.conn = sqlite3.connect(uri, uri=True, timeout=60.0)
         else:
-            parent = Path(self.path).parent
-            if self.path != ":memory:" and not parent.is_dir():
-                raise ConfigError(f"{self.path}: folder {parent} does not exist")
             self.conn = sqlite3.connect(self.path, timeout=60.0, isolation_level=None)
         self.conn.row_factory = sqlite3.Row
         try:

@@ -75,14 +75,9 @@ class Study:
 
 # --------------------------------------------------------------------------- loading
 def _connect(path: Path) -> sqlite3.Connection:
-    if not path.exists():
-        raise ConfigError(f"{path}: no such study database")
-    if path.is_dir():
-        raise ConfigError(f"{path}: is a folder, not a study database")
-    with open(path, "rb") as fh:
-        head = fh.read(16)
-    if head and head != b"SQLite format 3\x00":
-        raise ConfigError(f"{path}: not an SQLite database (write one with pathfuse bench)")
+    from pathfuse.bench.dbcheck import check_study_file
+
+    check_study_file(path, write=False)  # a folder, not SQLite, foreign, damaged
     try:
         conn = sqlite3.connect(path.resolve().as_uri() + "?mode=ro", uri=True, timeout=60.0)
         conn.row_factory = sqlite3.Row

@@ -82,7 +82,11 @@ def cmd_scen(args: argparse.Namespace) -> int:
     n_ok = n_bad = 0
     total_t = 0.0
     worst: list[str] = []
-    for p in problems:
+    _warm_with_notice("astar")
+    bar = _progress(len(problems), Path(args.scen).name, "lines", args)
+    for i, p in enumerate(problems):
+        if i and not i % 64:
+            bar.update(64)
         r = pathfuse.plan(grid, p.start, p.goal, planner="astar", heuristic=args.heuristic)
         total_t += r.time_s
         ok = r.success and abs(r.length - p.optimal_length) <= args.tol * max(1.0, p.optimal_length)
@@ -95,6 +99,8 @@ def cmd_scen(args: argparse.Namespace) -> int:
                     f"  line {p.line}: expected {p.optimal_length:.8f}, got "
                     f"{r.length:.8f} ({r.status.name})"
                 )
+    bar.update(len(problems) - bar.done)
+    bar.close()
     n = n_ok + n_bad
     print(f"{Path(args.scen).name}: {n_ok}/{n} lines match the optimal length "
           f"(rel. tol {args.tol:g}); A* time {total_t:.3f} s, "
@@ -104,16 +110,23 @@ def cmd_scen(args: argparse.Namespace) -> int:
     return 0 if n_bad == 0 else EXIT_FAIL
 
 
-def _warm_with_notice(planner: str) -> None:
-    """Compile the planner's kernels now, saying so first when numba's cache is cold."""
-    from pathfuse.planners.registry import get_planner
-    from pathfuse.planners.run import warm
+def _progress(total: int, label: str, unit: str, args: argparse.Namespace) -> Any:
+    """The progress display of a command (off with --quiet)."""
+    from pathfuse.bench.progress import ProgressBar
 
-    def notice() -> None:
-        print("pathfuse: compiling planner kernels (first run only; cached afterwards)",
-              file=sys.stderr, flush=True)
+    return ProgressBar(total, label=label, unit=unit,
+                       enabled=not getattr(args, "quiet", False))
 
-    warm(get_planner(planner), notify=notice)
+
+def _warm_with_notice(planner: str, world: bool = False) -> None:
+    """Compile the planner's kernels (and the world's) now, saying so first when numba's
+    cache is cold."""
+    from pathfuse.bench.warmup import warm_kernels
+
+    def notice(text: str) -> None:
+        print(f"pathfuse: {text}", file=sys.stderr, flush=True)
+
+    warm_kernels([planner], metrics=False, world=world, notify=notice)
 
 
 def planner_table() -> dict[str, Any]:
@@ -189,8 +202,6 @@ def cmd_paper(args: argparse.Namespace) -> int:
             f"--seed {cfg.figure_seed} is not among the maps run "
             f"({cfg.first_seed}..{cfg.first_seed + cfg.n_seeds - 1})"
         )
-    for name in cfg.planners:
-        _warm_with_notice(name)
     run = run_paper(cfg, progress=False if args.quiet else None, workers=args.workers,
                     db_path=_study_db(args.out))
     files = write_paper_outputs(run, args.out)
@@ -230,6 +241,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                   "params": {**dict(sc.planner.params), **params}}
     else:
         choice = {"name": args.planner, "params": params}
+    _warm_with_notice(str(choice["name"]), world=True)
     ep = simulate(sc, planner=choice, seed=args.seed)
     anim = None
     if out is not None:
@@ -283,8 +295,6 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
         planners=parse_planner_list(args.planners), seed=args.seed,
         params=parse_planner_params(args.param),
     )
-    for name in cfg.planners:
-        _warm_with_notice(name)
     run = run_dynamic(cfg, progress=False if args.quiet else None, workers=args.workers,
                       db_path=_study_db(args.out))
     files = write_dynamic_outputs(run, args.out)
@@ -353,21 +363,43 @@ def _announce_imports(path: str) -> None:
               "this code)", file=sys.stderr, flush=True)
 
 
+def _quiet_dask_logs() -> None:
+    """Dask logs a lost scheduler as tracebacks; the command says it in one line instead."""
+    import logging
+
+    try:
+        import distributed  # type: ignore[import-not-found]  # noqa: F401 - sets its levels
+    except ImportError:
+        return  # run_bench says how to install it
+    for name in ["distributed", *logging.root.manager.loggerDict]:
+        if name == "distributed" or name.startswith("distributed."):
+            logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
-    from pathfuse.bench import SweepInterrupted, run_bench
+    from pathfuse.bench import ClusterLost, SweepInterrupted, run_bench
 
     seeds = None if args.seeds is None else parse_seeds(args.seeds)
     _announce_imports(args.experiment)
+    if args.scheduler:  # a lost cluster is one line of ours, not Dask's tracebacks
+        _quiet_dask_logs()
     try:
         summary = run_bench(args.experiment, args.db, seeds=seeds, workers=args.workers,
                             scheduler=args.scheduler,
                             progress=False if args.no_progress else None,
-                            retry_errors=args.retry_errors, batch_size=args.batch_size)
+                            retry_errors=args.retry_errors, batch_size=args.batch_size,
+                            worker_wait_s=args.worker_wait)
     except SweepInterrupted as exc:
         print(exc.summary, flush=True)
-        print("pathfuse bench: interrupted; run the same command again to resume",
-              file=sys.stderr)
-        return 130
+        sig = getattr(exc, "signame", "")
+        how = f"terminated ({sig})" if sig else "interrupted"
+        print(f"pathfuse bench: {how}; run the same command again to resume", file=sys.stderr)
+        return 143 if sig == "SIGTERM" else 130
+    except ClusterLost as exc:
+        if exc.summary is not None:
+            print(exc.summary, flush=True)
+        print(f"pathfuse bench: error: {exc}", file=sys.stderr)
+        return EXIT_FAIL
     print(summary)
     return 0 if summary.errors == 0 else EXIT_FAIL
 

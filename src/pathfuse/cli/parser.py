@@ -101,6 +101,9 @@ examples:
     s.add_argument("--heuristic", default="octile", choices=["octile", "euclidean"],
                    help="A* heuristic (default octile; both are exact)")
     s.add_argument("--tol", type=_float, default=1e-6, help="relative tolerance (default 1e-6)")
+    s.add_argument("--quiet", action="store_true",
+                   help="no progress display (default on stderr: a live bar on a terminal, a "
+                   "few plain lines otherwise)")
     s.set_defaults(func=cmd_scen)
 
     pp = sub.add_parser(
@@ -130,7 +133,8 @@ examples:
                     help="output folder (default paper-out); its study.db keeps every run, "
                     "so running the same command again resumes or reuses them")
     pp.add_argument("--quiet", action="store_true",
-                    help="no progress bar (default: a bar on stderr when it is a terminal)")
+                    help="no progress display (default on stderr: a live bar on a terminal, a "
+                    "few plain lines otherwise)")
     pp.set_defaults(func=cmd_paper)
 
     sm = sub.add_parser(
@@ -211,7 +215,8 @@ examples:
                     help="output folder (default dynamic-out); its study.db keeps every "
                     "episode, so running the same command again resumes or reuses them")
     dy.add_argument("--quiet", action="store_true",
-                    help="no progress bar (default: a bar on stderr when it is a terminal)")
+                    help="no progress display (default on stderr: a live bar on a terminal, a "
+                    "few plain lines otherwise)")
     dy.set_defaults(func=cmd_dynamic)
 
     b = sub.add_parser(
@@ -247,12 +252,16 @@ See experiments/*.yaml for the file format (maps, seeds, planners, swept paramet
                    "process)")
     b.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                    help="run on a Dask distributed cluster (pip install 'pathfuse[dask]')")
+    b.add_argument("--worker-wait", type=_positive_float, default=60.0, metavar="SECONDS",
+                   help="with --scheduler: how long to wait when the cluster has no worker "
+                   "left before stopping (default 60; it says so after 5 s)")
     b.add_argument("--batch-size", type=_positive_int, default=None,
                    help="runs per task (default: about 8 tasks per worker, at most 64)")
     b.add_argument("--retry-errors", action="store_true",
                    help="run again the runs stored as ERROR")
     b.add_argument("--no-progress", action="store_true",
-                   help="no progress bar (default: a bar on stderr when it is a terminal)")
+                   help="no progress display (default on stderr: a live bar on a terminal, a "
+                   "few plain lines otherwise)")
     b.set_defaults(func=cmd_bench)
 
     r = sub.add_parser(
@@ -349,6 +358,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return EXIT_USAGE
     _one_line_warnings(args.command)
+    from pathfuse.bench.lifeline import terminate_like_ctrl_c
+
+    terminate_like_ctrl_c()  # SIGTERM ends a command like Ctrl-C: one line, stored runs kept
     try:
         return int(args.func(args) or 0)
     except PathfuseError as exc:
@@ -367,9 +379,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = f" {exc.filename}:" if getattr(exc, "filename", None) else ""
         print(f"pathfuse {args.command}: error:{where} {exc.strerror or exc}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print(f"pathfuse {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        sig = getattr(exc, "signame", "")
+        how = f"terminated ({sig})" if sig else "interrupted"
+        summary = getattr(exc, "summary", None)  # a sweep: its finished runs are stored
+        tail = ""
+        if summary is not None:
+            tail = (f"; {summary.skipped + summary.ran}/{summary.total} runs stored in "
+                    f"{summary.db_path}, run the same command again to finish the rest")
+        print(f"pathfuse {args.command}: {how}{tail}", file=sys.stderr)
+        return 143 if sig == "SIGTERM" else 130
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -267,7 +267,8 @@ def run_dynamic(
     config : DynamicConfig, optional
         Default ``DynamicConfig()``.
     progress : bool or None
-        Show the engine's progress bar (None: when stderr is a terminal).
+        False (default) shows nothing; True or None show the engine's progress display
+        (a live bar on a terminal, a few plain lines elsewhere).
     workers : int or None
         Processes of the engine's pool (1: in this process; None: every CPU).
         The records (timings aside) do not depend on it, and come back in the
@@ -292,7 +293,7 @@ def run_dynamic(
     store = ResultStore(":memory:" if db_path is None else db_path)
     try:
         summary = run_experiment(exp, store, workers=workers, progress=progress, stream=stream,
-                                 label="dynamic")
+                                 label="dynamic", unit="episodes")
         stored = store.rows_by_key([r.key for r in specs])
     finally:
         store.close()

@@ -174,17 +174,19 @@ def _study_db(out: str) -> Path:
 def cmd_paper(args: argparse.Namespace) -> int:
     from pathfuse.studies.paper import PaperConfig, run_paper, summary_rows, write_paper_outputs
 
+    variants = ("pathfuse", "paper") if args.variant == "both" else (args.variant,)
     cfg = PaperConfig(
         n_seeds=args.seeds, first_seed=args.first_seed,
         figure_seed=args.seed if args.seed is not None else args.first_seed,
-        step_m=args.step,
+        step_m=args.step, variants=variants, corner_cutting=args.corner_cutting,
+        **({"references": ()} if args.no_references else {}),
     )
     if not cfg.first_seed <= cfg.figure_seed < cfg.first_seed + cfg.n_seeds:
         raise CliError(
             f"--seed {cfg.figure_seed} is not among the maps run "
             f"({cfg.first_seed}..{cfg.first_seed + cfg.n_seeds - 1})"
         )
-    for name in cfg.planners:
+    for name in (*cfg.planners, *cfg.references):
         _warm_with_notice(name)
     run = run_paper(cfg, progress=False if args.quiet else None, workers=args.workers,
                     db_path=_study_db(args.out))
@@ -194,11 +196,13 @@ def cmd_paper(args: argparse.Namespace) -> int:
     print(f"{n_runs} runs on {cfg.n_seeds} maps: {sm.ran} run now in {run.wall_s:.2f} s "
           f"({sm.runs_per_s:.0f} runs/s, {sm.workers} worker{'s' if sm.workers != 1 else ''})"
           + (f", {sm.skipped} already in {sm.db_path}" if sm.skipped else ""))
-    print(f"{'planner':<8} {'success':>12} {'length mean':>12} {'R_length':>10} {'time mean':>11}")
+    print(f"{'variant':<9} {'planner':<13} {'success':>12} {'length mean':>12} {'R_length':>10} "
+          f"{'excess':>9} {'time mean':>11}")
     for r in summary_rows(run):
-        rl = "-" if r["planner"] == "fusion" else f"{100 * r['r_length_mean']:+.2f}%"
-        print(f"{r['planner']:<8} {r['successes']:>5}/{r['maps']:<6} "
-              f"{r['length_mean_m']:>11.4f}m {rl:>10} {1e3 * r['time_mean_s']:>9.3f}ms")
+        rl = "-" if r["is_fusion"] else f"{100 * r['r_length_mean']:+.2f}%"
+        ex = "-" if not r["excess_pairs"] else f"{100 * r['excess_mean']:+.2f}%"
+        print(f"{r['variant']:<9} {r['planner']:<13} {r['successes']:>5}/{r['maps']:<6} "
+              f"{r['length_mean_m']:>11.4f}m {rl:>10} {ex:>9} {1e3 * r['time_mean_s']:>9.3f}ms")
     for path in files.values():
         print(f"wrote {path}")
     return 0
@@ -278,7 +282,7 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
         planners=parse_planner_list(args.planners), seed=args.seed,
         params=parse_planner_params(args.param),
     )
-    for name in cfg.planners:
+    for name in (*cfg.planners, *cfg.references):
         _warm_with_notice(name)
     run = run_dynamic(cfg, progress=False if args.quiet else None, workers=args.workers,
                       db_path=_study_db(args.out))

@@ -174,12 +174,14 @@ def _study_db(out: str) -> Path:
 def cmd_paper(args: argparse.Namespace) -> int:
     from pathfuse.studies.paper import PaperConfig, run_paper, summary_rows, write_paper_outputs
 
+    from pathfuse.studies.paper import REFERENCES
+
     variants = ("pathfuse", "paper") if args.variant == "both" else (args.variant,)
     cfg = PaperConfig(
         n_seeds=args.seeds, first_seed=args.first_seed,
         figure_seed=args.seed if args.seed is not None else args.first_seed,
         step_m=args.step, variants=variants, corner_cutting=args.corner_cutting,
-        **({"references": ()} if args.no_references else {}),
+        references=() if args.no_references else REFERENCES,
     )
     if not cfg.first_seed <= cfg.figure_seed < cfg.first_seed + cfg.n_seeds:
         raise CliError(
@@ -282,7 +284,7 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
         planners=parse_planner_list(args.planners), seed=args.seed,
         params=parse_planner_params(args.param),
     )
-    for name in (*cfg.planners, *cfg.references):
+    for name in cfg.planners:
         _warm_with_notice(name)
     run = run_dynamic(cfg, progress=False if args.quiet else None, workers=args.workers,
                       db_path=_study_db(args.out))

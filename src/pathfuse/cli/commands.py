@@ -172,9 +172,13 @@ def _study_db(out: str) -> Path:
 
 
 def cmd_paper(args: argparse.Namespace) -> int:
-    from pathfuse.studies.paper import PaperConfig, run_paper, summary_rows, write_paper_outputs
-
-    from pathfuse.studies.paper import REFERENCES
+    from pathfuse.studies.paper import (
+        REFERENCES,
+        PaperConfig,
+        run_paper,
+        summary_rows,
+        write_paper_outputs,
+    )
 
     variants = ("pathfuse", "paper") if args.variant == "both" else (args.variant,)
     cfg = PaperConfig(

@@ -146,7 +146,8 @@ def cmd_planners(args: argparse.Namespace) -> int:
     for name, d in table.items():
         runs = " and ".join(k for k in ("offline", "online") if d[k])
         also = f"; also called {', '.join(d['aliases'])}" if d["aliases"] else ""
-        parts = ["global planner: A*" if d["global_planner"] == "astar" else "",
+        gp = d["global_planner"]
+        parts = [f"global planner: {'A*' if gp == 'astar' else gp}" if gp else "",
                  f"controller: {d['controller']}" if d["controller"] else "a plug-in function"]
         print(f"{name}  ({'; '.join(x for x in parts if x)}; runs {runs}{also})")
         print(f"  {d['description']}")
@@ -156,7 +157,7 @@ def cmd_planners(args: argparse.Namespace) -> int:
                 print(f"    {p['name']} = {p['default']!r}{unit}  ({p['accepts']}): {p['help']}")
         else:
             shown = ", ".join(f"{p['name']}={p['default']!r}" for p in d["params"])
-            print(f"  parameters: {shown}")
+            print(f"  parameters: {shown or 'none'}")
     if not args.params:
         print("\n'pathfuse planners --params' explains every parameter (unit, range, meaning).")
     return 0

@@ -155,6 +155,6 @@ register(PlannerSpec(
     name="apf",
     params_cls=APFParams,
     description="artificial potential field (paper eq. 3-6): one step at a time along the "
-                "resultant force, never into an obstacle",
+                "resultant force, never into an obstacle (safe_step=false: the paper's full step)",
     controller=APFController,
 ))

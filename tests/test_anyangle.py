@@ -263,3 +263,16 @@ def test_budget_and_time_limit():
         assert r.status is Status.MAX_ITERATIONS and r.expansions == 2, name
         r = plan(g, PAPER_START, PAPER_GOAL, planner=name, budget=Budget(time_limit_s=5.0))
         assert r.success, name
+
+
+def test_upper_bound_never_changes_the_answer():
+    for seed in range(20):
+        g = paper_map(seed)
+        args = (g.occupied, *g.origin, g.resolution, 0.0, PAPER_START, PAPER_GOAL)
+        free = shortest_path(*args)
+        astar = plan(g, PAPER_START, PAPER_GOAL).length
+        for bound in (astar, free.length, 0.5 * free.length, 1e9):
+            r = shortest_path(*args, upper_bound_m=bound)
+            assert r.status is Status.SUCCESS
+            np.testing.assert_array_equal(r.points, free.points)
+            assert r.length == free.length

@@ -123,8 +123,12 @@ def plan_any_angle(kind: str, problem: Problem, params: Any,
         from pathfuse.search.visibility import shortest_path
 
         t0 = time.perf_counter()
+        # the A* path's length bounds the search (an ellipse of useful corners); the
+        # visibility graph's answer does not depend on it (see shortest_path)
+        gp = plan_global(problem, "octile", False)
+        bound = _length(gp.waypoints) if gp.success else None
         res_ = shortest_path(grid.occupied, ox, oy, res, r, problem.start, problem.goal,
-                             max_expansions, limit)
+                             max_expansions, limit, upper_bound_m=bound)
         elapsed = time.perf_counter() - t0
         return _from_result(res_, problem, elapsed, "visibility graph")
     if kind not in ("thetastar", "lazy-thetastar"):
@@ -221,7 +225,9 @@ def _warm(kind: str) -> None:
                     0.0, 1.0, 1e-6)
     elif kind == "shortest":
         from pathfuse.search import visibility
+        from pathfuse.search.astar import warmup as astar_warmup
 
+        astar_warmup()
         visibility.warmup()
 
 
@@ -235,9 +241,10 @@ def _kernels(kind: str) -> Sequence[Any]:
         from pathfuse.search.los import smooth_path
 
         return (_astar_kernel, smooth_path)
+    from pathfuse.search.kernel import _astar_kernel
     from pathfuse.search.visibility import _vis_kernel, convex_corners
 
-    return (_vis_kernel, convex_corners)
+    return (_astar_kernel, _vis_kernel, convex_corners)
 
 
 _DESCRIPTIONS = {

@@ -269,13 +269,19 @@ def _outside_squares(x: float, y: float, occ: np.ndarray, q: float) -> bool:
 
 def shortest_path(occ: np.ndarray, ox: float, oy: float, res: float, robot_radius_m: float,
                   start: tuple[float, float], goal: tuple[float, float],
-                  max_expansions: int | None = None,
-                  time_limit_s: float | None = None) -> AnyAngleResult:
+                  max_expansions: int | None = None, time_limit_s: float | None = None,
+                  upper_bound_m: float | None = None) -> AnyAngleResult:
     """The shortest path from ``start`` to ``goal`` (world metres; see the module docstring).
 
     ``NO_PATH`` also when the start or the goal lies within the growth
     ``rho`` (L-infinity) of a square or the map's edge.  ``max_expansions``
     caps the vertices expanded (``MAX_ITERATIONS``).
+
+    ``upper_bound_m``, the length of any path (an A* path, say), speeds the
+    search up without changing its answer: only corners ``v`` with ``|s v| +
+    |v g|`` within the bound can lie on a shorter path (an ellipse), and the
+    goal starts with that distance.  If no path within the bound is found
+    (the bound was not a path's length), the search runs again without it.
     """
     t0 = time.perf_counter()
     occ = np.ascontiguousarray(occ, dtype=np.bool_)
@@ -286,11 +292,34 @@ def shortest_path(occ: np.ndarray, ox: float, oy: float, res: float, robot_radiu
         if not _outside_squares(x, y, occ, q):
             return AnyAngleResult(Status.NO_PATH, np.zeros((0, 2)), math.inf, 0)
     cx, cy, ct = _corners_cached(occ, q)
+    used = 0
+    if upper_bound_m is not None and math.isfinite(upper_bound_m):
+        bound = upper_bound_m / res * (1.0 + 1e-9) + 1e-9
+        keep = np.hypot(cx - sx, cy - sy) + np.hypot(cx - gx, cy - gy) <= bound
+        out = _search(occ, q, cx[keep], cy[keep], ct[keep], sx, sy, gx, gy, start, goal, ox,
+                      oy, res, max_expansions, time_limit_s, t0, bound)
+        if out.status is not Status.NO_PATH:
+            return out
+        used = out.expansions
+        if max_expansions is not None:
+            max_expansions = max(int(max_expansions) - used, 0)
+    out = _search(occ, q, cx, cy, ct, sx, sy, gx, gy, start, goal, ox, oy, res, max_expansions,
+                  time_limit_s, t0, math.inf)
+    out.expansions += used
+    return out
+
+
+def _search(occ: np.ndarray, q: float, cx: np.ndarray, cy: np.ndarray, ct: np.ndarray,
+            sx: float, sy: float, gx: float, gy: float, start: tuple[float, float],
+            goal: tuple[float, float], ox: float, oy: float, res: float,
+            max_expansions: int | None, time_limit_s: float | None, t0: float,
+            bound: float) -> AnyAngleResult:
     n = cx.shape[0] + 2
     xs = np.concatenate([cx, [sx, gx]])
     ys = np.concatenate([cy, [sy, gy]])
     ts = np.concatenate([ct, [0, 0]]).astype(np.int64)
     g = np.full(n, math.inf)
+    g[n - 1] = bound
     parent = np.full(n, -1, dtype=np.int64)
     closed = np.zeros(n, dtype=np.bool_)
     hkey = np.empty(max(64, n))
@@ -308,7 +337,7 @@ def shortest_path(occ: np.ndarray, ox: float, oy: float, res: float, robot_radiu
                                   int(meta[1]))
         code, hkey, hnode = _vis_kernel(occ, q, xs, ys, ts, g, parent, closed, hkey, hnode,
                                         meta, step)
-        if code == 0:
+        if code == 0 and parent[n - 1] >= 0:
             chain = [n - 1]
             while chain[-1] != n - 2:
                 chain.append(int(parent[chain[-1]]))
@@ -317,7 +346,7 @@ def shortest_path(occ: np.ndarray, ox: float, oy: float, res: float, robot_radiu
             pts[0] = start
             pts[-1] = goal
             return AnyAngleResult(Status.SUCCESS, pts, float(g[n - 1]) * res, int(meta[1]))
-        if code == 1:
+        if code != 2:
             return AnyAngleResult(Status.NO_PATH, np.zeros((0, 2)), math.inf, int(meta[1]))
         if int(meta[1]) >= budget:
             return AnyAngleResult(Status.MAX_ITERATIONS, np.zeros((0, 2)), math.inf,

@@ -36,6 +36,10 @@ Statistics (every row):
   experiment file named (the stored ``runs.R_length``: the reference
   planner, or the optimum of a MovingAI scen line); ``reference=`` picks a
   planner or planner configuration of the study instead.
+* excess over the shortest path = (L - L_shortest) / L_shortest, when the
+  study ran the ``shortest`` planner: each solved run paired with
+  ``shortest``'s solved run on the same problem and seed (``excess_pairs``;
+  :func:`~pathfuse.bench.study.excess_values`).
 
 A swept parameter is one that takes more than one value among the
 configurations of a planner (per run kind), read from the configurations'
@@ -157,6 +161,9 @@ def _table(rows: Sequence[Mapping[str, Any]], first: Sequence[tuple[str, str]],
         head += ["collisions [95% CI]", "time to goal (s) mean [95% CI]", "median"]
     head += ["length (m) mean [95% CI]", "median", "time (ms) mean [95% CI]", "median",
              "R_length mean [95% CI]", "median", "pairs", "shorter"]
+    excess = any(r.get("excess_pairs") for r in rows)
+    if excess:
+        head += ["excess over the shortest path mean [95% CI]", "median", "pairs"]
     table = [head]
     for r in rows:
         line = [str(r[k]) for _, k in first] + [
@@ -175,6 +182,12 @@ def _table(rows: Sequence[Mapping[str, Any]], first: Sequence[tuple[str, str]],
                  str(r["r_length_pairs"]),
                  f"{r['r_length_shorter']}/{r['r_length_pairs']}" if r["r_length_pairs"]
                  else "n/a"]
+        if excess:
+            n = r.get("excess_pairs", 0)
+            line += ["n/a" if not n else
+                     f"{100 * r['excess_mean']:+.2f}% [{100 * r['excess_ci_low']:+.2f}, "
+                     f"{100 * r['excess_ci_high']:+.2f}]",
+                     "n/a" if not n else f"{100 * r['excess_median']:+.2f}%", str(n)]
         table.append(line)
     return table
 
@@ -209,7 +222,10 @@ _NOTES = (
     "interval. R_length = (L - L_ref) / L_ref over the runs where the run and its "
     "reference both solved the same problem (problem_key + seed); pairs = how many; "
     "shorter = pairs where the configuration's path is shorter than the reference's. "
-    "R_length < 0: shorter than the reference."
+    "R_length < 0: shorter than the reference. When the study ran the planner shortest (the "
+    "true shortest path among the occupied squares), the excess over the shortest path = "
+    "(L - L_shortest) / L_shortest pairs every solved run with shortest's on the same "
+    "problem and seed."
 )
 
 

@@ -164,7 +164,8 @@ def cmd_planners(args: argparse.Namespace) -> int:
     for name, d in table.items():
         runs = " and ".join(k for k in ("offline", "online") if d[k])
         also = f"; also called {', '.join(d['aliases'])}" if d["aliases"] else ""
-        parts = ["global planner: A*" if d["global_planner"] == "astar" else "",
+        gp = d["global_planner"]
+        parts = [f"global planner: {'A*' if gp == 'astar' else gp}" if gp else "",
                  f"controller: {d['controller']}" if d["controller"] else "a plug-in function"]
         print(f"{name}  ({'; '.join(x for x in parts if x)}; runs {runs}{also})")
         print(f"  {d['description']}")
@@ -174,7 +175,7 @@ def cmd_planners(args: argparse.Namespace) -> int:
                 print(f"    {p['name']} = {p['default']!r}{unit}  ({p['accepts']}): {p['help']}")
         else:
             shown = ", ".join(f"{p['name']}={p['default']!r}" for p in d["params"])
-            print(f"  parameters: {shown}")
+            print(f"  parameters: {shown or 'none'}")
     if not args.params:
         print("\n'pathfuse planners --params' explains every parameter (unit, range, meaning).")
     return 0
@@ -190,12 +191,20 @@ def _study_db(out: str) -> Path:
 
 
 def cmd_paper(args: argparse.Namespace) -> int:
-    from pathfuse.studies.paper import PaperConfig, run_paper, summary_rows, write_paper_outputs
+    from pathfuse.studies.paper import (
+        REFERENCES,
+        PaperConfig,
+        run_paper,
+        summary_rows,
+        write_paper_outputs,
+    )
 
+    variants = ("pathfuse", "paper") if args.variant == "both" else (args.variant,)
     cfg = PaperConfig(
         n_seeds=args.seeds, first_seed=args.first_seed,
         figure_seed=args.seed if args.seed is not None else args.first_seed,
-        step_m=args.step,
+        step_m=args.step, variants=variants, corner_cutting=args.corner_cutting,
+        references=() if args.no_references else REFERENCES,
     )
     if not cfg.first_seed <= cfg.figure_seed < cfg.first_seed + cfg.n_seeds:
         raise CliError(
@@ -210,11 +219,13 @@ def cmd_paper(args: argparse.Namespace) -> int:
     print(f"{n_runs} runs on {cfg.n_seeds} maps: {sm.ran} run now in {run.wall_s:.2f} s "
           f"({sm.runs_per_s:.0f} runs/s, {sm.workers} worker{'s' if sm.workers != 1 else ''})"
           + (f", {sm.skipped} already in {sm.db_path}" if sm.skipped else ""))
-    print(f"{'planner':<8} {'success':>12} {'length mean':>12} {'R_length':>10} {'time mean':>11}")
+    print(f"{'variant':<9} {'planner':<13} {'success':>12} {'length mean':>12} {'R_length':>10} "
+          f"{'excess':>9} {'time mean':>11}")
     for r in summary_rows(run):
-        rl = "-" if r["planner"] == "fusion" else f"{100 * r['r_length_mean']:+.2f}%"
-        print(f"{r['planner']:<8} {r['successes']:>5}/{r['maps']:<6} "
-              f"{r['length_mean_m']:>11.4f}m {rl:>10} {1e3 * r['time_mean_s']:>9.3f}ms")
+        rl = "-" if r["is_fusion"] else f"{100 * r['r_length_mean']:+.2f}%"
+        ex = "-" if not r["excess_pairs"] else f"{100 * r['excess_mean']:+.2f}%"
+        print(f"{r['variant']:<9} {r['planner']:<13} {r['successes']:>5}/{r['maps']:<6} "
+              f"{r['length_mean_m']:>11.4f}m {rl:>10} {ex:>9} {1e3 * r['time_mean_s']:>9.3f}ms")
     for path in files.values():
         print(f"wrote {path}")
     return 0

@@ -112,11 +112,17 @@ examples:
         description="Run the paper's setup (15 m map, start (1, 1), goal (11, 11), 50 random "
         "obstacles, K_att 40, K_rep 5, rho_0 2 m) with all five planners on N seeded maps and "
         "write Tables I and II (one map and statistics over all maps) as Markdown and CSV, "
-        "Fig. 3 and a box plot of R_length into --out.",
+        "Fig. 3 and a box plot of R_length into --out. Every table also holds A* with "
+        "line-of-sight smoothing, Theta* and the true shortest path, and each planner's excess "
+        "over the shortest path. --variant paper runs apf, ref6, ref7 and fusion as printed "
+        "(eq. 8, no escape, the full step along the force: a step that touches an obstacle is "
+        "a COLLISION; no stall test); --variant pathfuse with pathfuse's defaults; both (the "
+        "default) gives one table per variant.",
         epilog=_fmt("""
 examples:
   pathfuse paper --out paper-out
   pathfuse paper --seeds 1000 --seed 7 --out paper-1000
+  pathfuse paper --seeds 1000 --variant paper --corner-cutting --out paper-as-printed
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -127,6 +133,7 @@ examples:
                     help="the map of the one-map tables and Fig. 3 (default: the first seed)")
     pp.add_argument("--step", type=_float, default=0.1,
                     help="step length in metres of every stepping planner (default 0.1)")
+    _add_paper_variant_options(pp)
     pp.add_argument("--workers", type=_positive_int, default=None,
                     help="worker processes (default: every usable CPU; 1 = in this process)")
     pp.add_argument("--out", default="paper-out",
@@ -393,4 +400,17 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
+
+
+def _add_paper_variant_options(pp: argparse.ArgumentParser) -> None:
+    """``pathfuse paper``'s variant, corner rule and references."""
+    pp.add_argument("--variant", choices=["both", "pathfuse", "paper"], default="both",
+                    help="the stepping planners with pathfuse's defaults, as printed in the "
+                    "paper, or both, one table each (default both)")
+    pp.add_argument("--corner-cutting", action="store_true",
+                    help="the A* reference cuts corners (the paper's 14.7279 m is a "
+                    "corner-cutting length); default: no corner cutting")
+    pp.add_argument("--no-references", action="store_true",
+                    help="leave out astar-smooth, thetastar and shortest (and the excess "
+                    "over the shortest path)")
 

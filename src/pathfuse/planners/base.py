@@ -28,6 +28,7 @@ import numpy as np
 
 from pathfuse.field.kernels import (
     CODE_BLOCKED,
+    CODE_COLLISION,
     CODE_GOAL,
     CODE_GOAL_SNAP,
     CODE_RUNNING,
@@ -268,6 +269,9 @@ class FieldController(Controller):
         where = f"at ({x:.3f}, {y:.3f}), {math.hypot(x - gx, y - gy):.3f} m from the goal"
         if code == CODE_BLOCKED:
             return f"blocked {where}: no collision-free move along the force"
+        if code == CODE_COLLISION:
+            return (f"collision {where}: the full step along the force touches an obstacle "
+                    "(safe_step=false, the paper's rule)")
         if code == CODE_STALLED:
             return (f"local minimum {where}: moved less than {self.stall_distance_m:g} m "
                     f"over the last {self.params.stall_steps} steps")

@@ -78,9 +78,9 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     deadline = (time.perf_counter() + budget.time_limit_s
                 if budget.time_limit_s is not None else None)
     gp = None
-    if spec.uses_astar:
-        gp = plan_global(problem, params.heuristic, bool(getattr(params, "corner_cutting", False)),
-                         max_expansions=budget.max_iterations if ctrl_cls.search_budget else None)
+    if spec.global_planner is not None:
+        gp = _global(spec, problem, params,
+                     budget.max_iterations if ctrl_cls.search_budget else None)
         if not gp.success:
             msg = gp.message if ctrl_cls.search_budget else f"A* failed: {gp.message}"
             return PlanResult(gp.status, time_s=gp.time_s, planner=spec.name,
@@ -90,6 +90,18 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     length = out.length_m if out.length_m is not None else path_length(out.path)
     return PlanResult(out.status, out.path, length, (gp.time_s if gp else 0.0) + out.time_s,
                       spec.name, gp.expansions if gp else 0, out.steps, out.message, info)
+
+
+def _global(spec: PlannerSpec, problem: Problem, params: Any,
+            max_expansions: int | None = None) -> GlobalPlan:
+    """The global plan of ``spec``: grid A*, or an any-angle planner."""
+    if spec.uses_astar:
+        return plan_global(problem, params.heuristic,
+                           bool(getattr(params, "corner_cutting", False)),
+                           max_expansions=max_expansions)
+    from pathfuse.planners.anyangle import plan_any_angle
+
+    return plan_any_angle(str(spec.global_planner), problem, params, max_expansions)
 
 
 def _renamed(res: PlanResult, name: str) -> PlanResult:
@@ -123,10 +135,10 @@ def start_online(spec: PlannerSpec, problem: Problem, params: Any, dt: float,
                           "it cannot be simulated")
     warm(spec)
     gp = None
-    if spec.uses_astar:
-        gp = plan_global(problem, params.heuristic,
-                         bool(getattr(params, "corner_cutting", False)))
+    if spec.global_planner is not None:
+        gp = _global(spec, problem, params)
         if not gp.success:
+            what = "A*" if spec.uses_astar else spec.global_planner
             return Stopped(problem, params, gp.status,
-                           f"A* found no path for the robot on the static map: {gp.message}")
+                           f"{what} found no path for the robot on the static map: {gp.message}")
     return spec.controller(problem, params, gp, dt=dt, max_speed=max_speed)

@@ -33,6 +33,7 @@ examples:
   pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 500
   pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
   pathfuse dynamic --seeds 50 --moving 0 2 4 8 --out dynamic-out
+  pathfuse barn ../shared/data/barn --worlds 0-24 --out barn-out
   pathfuse bench experiments/fusion-sweep-r1-r2-step.yaml --db sweep.db --seeds 20
   pathfuse report sweep.db --out sweep-report
   pathfuse planners

@@ -17,6 +17,7 @@ from pathfuse.cli.args import (
     _positive_float,
     _positive_int,
 )
+from pathfuse.cli.barn import add_barn_parser
 from pathfuse.cli.commands import (
     cmd_bench,
     cmd_dynamic,
@@ -208,6 +209,8 @@ examples:
     dy.add_argument("--quiet", action="store_true",
                     help="no progress bar (default: a bar on stderr when it is a terminal)")
     dy.set_defaults(func=cmd_dynamic)
+
+    add_barn_parser(sub)
 
     b = sub.add_parser(
         "bench",

@@ -33,8 +33,8 @@ holonomic unless a robot model says otherwise.
 
 Examples
 --------
->>> round(reference_length(np.array([[12, 0], [12, 29]])), 4)   # straight up the middle
-10.2555
+>>> round(reference_length(np.array([[12, 0], [12, 29]])), 4)   # x = -2.775: off-centre
+10.223
 >>> barn_metric(True, 3.0, 5.0), barn_metric(True, 30.0, 5.0), barn_metric(False, 3.0, 5.0)
 (0.5, 0.16666666666666666, 0.0)
 >>> parse_world_selection("0-3,17, 20")
@@ -381,7 +381,7 @@ def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: f
     blob = row.get("path")
     pos = np.frombuffer(blob, dtype="<f8").reshape(-1, 2) if blob else \
         np.asarray([BARN_START], dtype=np.float64)
-    times = np.arange(pos.shape[0], dtype=np.float64) * dt
+    times = np.round(np.arange(pos.shape[0], dtype=np.float64) * dt, 9)
     status = str(row["status_name"])
     moved = np.hypot(pos[:, 0] - BARN_START[0], pos[:, 1] - BARN_START[1]) >= BARN_MOVE_START_M
     t_start = float(times[int(np.argmax(moved))]) if moved.any() else 0.0
@@ -395,7 +395,7 @@ def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: f
         "planner": planner,
         "status": outcome,
         "pathfuse_status": status,
-        "time_s": float(time_s),
+        "time_s": round(float(time_s), 9),
         "metric": barn_metric(success, time_s, optimal_time_s),
         "optimal_time_s": float(optimal_time_s),
         "reference_length_m": float(optimal_time_s * REFERENCE_SPEED_M_S),

@@ -407,7 +407,11 @@ def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: f
         "message": row.get("message") or "",
     }
     if trajectory:
-        rec["trajectory"] = trajectory_with_yaw(times, pos)
+        hblob = row.get("headings")
+        headings = np.frombuffer(hblob, dtype="<f8") if hblob else None
+        if headings is not None and headings.shape[0] != pos.shape[0]:
+            headings = None
+        rec["trajectory"] = trajectory_with_yaw(times, pos, headings=headings)
     return rec
 
 

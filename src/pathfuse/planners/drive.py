@@ -22,8 +22,10 @@ as it is.  A diff-drive robot gets ``(v, omega)`` from
    ``radius`` (plus :data:`~pathfuse.geometry.MARGIN_FRAC` of a cell) clear
    of every occupied square and the map's edge
    (:func:`~pathfuse.sweep.arc_static_distance`, exact).  Otherwise the
-   speed is lowered in 8 even steps towards the lowest speed of the window,
-   which is taken if nothing else passes (the world then judges it).
+   speed is lowered in 8 even steps towards the lowest speed of the window;
+   if none passes, the same with the yaw rates of the window nearest the
+   desired one (the last one, 0, either extreme).  If nothing passes, the
+   lowest speed with the desired yaw rate is taken (the world judges it).
 
 So a robot that can brake in time never drives into a wall because of the
 conversion, turning on the spot is always allowed (the footprint is a
@@ -104,13 +106,26 @@ def unicycle_command(occ: np.ndarray, ox: float, oy: float, res: float, x: float
     vlo = max(vmin, v0 - amax * dt)
     vhi = min(vmax, v0 + amax * dt)
     v = min(max(v_des, vlo), vhi)
-    for k in range(9):
-        vk = v - (v - vlo) * (k / 8.0)
-        brake = 0.0
-        if vk > 0.0 and math.isfinite(amax):
-            brake = vk * vk / (2.0 * amax)
-        if admissible(occ, ox, oy, res, x, y, th, vk, w, dt, brake, clear):
-            return vk, w
+    # the desired yaw rate first; if no speed is admissible with it, the yaw rates of the
+    # window nearest to it (keep turning, go straight, turn hard either way)
+    for j in range(5):
+        if j == 0:
+            wj = w
+        elif j == 1:
+            wj = min(max(w0, wlo), whi)
+        elif j == 2:
+            wj = min(max(0.0, wlo), whi)
+        elif j == 3:
+            wj = wlo if abs(wlo - w) > abs(whi - w) else whi
+        else:
+            wj = whi if abs(wlo - w) > abs(whi - w) else wlo
+        for k in range(9):
+            vk = v - (v - vlo) * (k / 8.0)
+            brake = 0.0
+            if vk > 0.0 and math.isfinite(amax):
+                brake = vk * vk / (2.0 * amax)
+            if admissible(occ, ox, oy, res, x, y, th, vk, wj, dt, brake, clear):
+                return vk, wj
     return vlo, w
 
 

@@ -50,7 +50,7 @@ def test_metric_clips_between_2_and_8_optimal_times(time_s, metric):
 
 
 def test_world_selection_and_folder_errors(tmp_path):
-    assert parse_world_selection("20, 0-1,17") == (0, 1, 17, 20)
+    assert parse_world_selection("20, 0-1,17") == ((0, 1), (17, 17), (20, 20))
     assert parse_world_selection(None) is None
     for bad in ("", "a", "3-1", "1,,x"):
         with pytest.raises(ConfigError, match="worlds"):
@@ -59,6 +59,9 @@ def test_world_selection_and_folder_errors(tmp_path):
     assert [w.index for w in find_worlds(BARN / "worlds", [20])] == [20]
     with pytest.raises(ConfigError, match="no world file for index 5"):
         find_worlds(BARN, [5])
+    assert [w.index for w in find_worlds(BARN, "0-18")] == [0, 17]  # a range: those present
+    with pytest.raises(ConfigError, match="no world file in 1-16"):
+        find_worlds(BARN, "1-16")
     with pytest.raises(ConfigError, match="no such folder"):
         find_worlds(tmp_path / "nope")
     with pytest.raises(ConfigError, match="no BARN world"):

@@ -38,7 +38,7 @@ Examples
 >>> barn_metric(True, 3.0, 5.0), barn_metric(True, 30.0, 5.0), barn_metric(False, 3.0, 5.0)
 (0.5, 0.16666666666666666, 0.0)
 >>> parse_world_selection("0-3,17, 20")
-(0, 1, 2, 3, 17, 20)
+((0, 3), (17, 17), (20, 20))
 """
 
 from __future__ import annotations
@@ -123,33 +123,38 @@ def barn_metric(success: bool, time_s: float, optimal_time_s: float) -> float:
     return float(optimal_time_s / min(max(time_s, 2.0 * optimal_time_s), 8.0 * optimal_time_s))
 
 
-def parse_world_selection(text: str | Sequence[int] | None) -> tuple[int, ...] | None:
-    """``"0-9,17,100-120"`` (inclusive ranges) -> sorted unique indices; None = every world."""
+def parse_world_selection(text: str | Sequence[int] | None
+                          ) -> tuple[tuple[int, int], ...] | None:
+    """``"0-9,17,100-120"`` -> sorted, merged inclusive ranges ``((first, last), ...)``;
+    a single index ``i`` is ``(i, i)``.  None selects every world.
+
+    :func:`find_worlds` requires each single index to exist and takes the worlds
+    that exist inside a range (the shipped set has holes).
+    """
     if text is None:
         return None
+    out: list[tuple[int, int]] = []
     if not isinstance(text, str):
         vals = list(text)
-        if not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= 0
-                   for v in vals) or not vals:
+        if not vals or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool)
+                               and v >= 0 for v in vals):
             raise ConfigError(f"worlds: expected indices >= 0, got {text!r}")
-        return tuple(sorted({int(v) for v in vals}))
-    out: set[int] = set()
-    for part in text.split(","):
-        part = part.strip()
-        m = re.fullmatch(r"(\d+)\s*-\s*(\d+)", part)
-        if m:
-            a, b = int(m.group(1)), int(m.group(2))
-            if a > b:
-                raise ConfigError(f"worlds: range {part!r} runs backwards")
-            out.update(range(a, b + 1))
-        elif part.isdigit():
-            out.add(int(part))
-        else:
-            raise ConfigError(f"worlds: expected indices and ranges such as 0-9,17, got "
-                              f"{text!r}")
-    if not out:
-        raise ConfigError(f"worlds: no index in {text!r}")
-    return tuple(sorted(out))
+        out = [(int(v), int(v)) for v in vals]
+    else:
+        for part in text.split(","):
+            part = part.strip()
+            m = re.fullmatch(r"(\d+)\s*-\s*(\d+)", part)
+            if m:
+                a, b = int(m.group(1)), int(m.group(2))
+                if a > b:
+                    raise ConfigError(f"worlds: range {part!r} runs backwards")
+                out.append((a, b) if a < b else (a, a))
+            elif part.isdigit():
+                out.append((int(part), int(part)))
+            else:
+                raise ConfigError(f"worlds: expected indices and ranges such as 0-9,17, got "
+                                  f"{text!r}")
+    return tuple(sorted(set(out)))
 
 
 @dataclass(frozen=True)
@@ -177,12 +182,14 @@ _WORLD_RE = re.compile(r"world_(\d+)\.world(\.gz)?$")
 
 
 def find_worlds(directory: str | os.PathLike[str],
-                indices: Sequence[int] | None = None) -> list[BarnWorld]:
+                selection: Any = None) -> list[BarnWorld]:
     """The worlds of a BARN folder, by index.
 
     ``directory`` holds ``worlds/world_N.world[.gz]`` and ``path_files/path_N.npy``
     (as shipped), or is the ``worlds`` folder itself with ``path_files`` beside
-    it.  ``indices`` selects worlds (every one listed must exist).
+    it.  ``selection`` (:func:`parse_world_selection`'s ranges, its text, or a list
+    of indices) picks worlds: every single index must exist, a range takes the
+    worlds inside it.
 
     Raises
     ------
@@ -204,11 +211,21 @@ def find_worlds(directory: str | os.PathLike[str],
             found.setdefault(int(m.group(1)), f)
     if not found:
         raise ConfigError(f"{wdir}: no BARN world (world_N.world or world_N.world.gz) in it")
-    chosen = sorted(found) if indices is None else list(indices)
-    missing = [i for i in chosen if i not in found]
-    if missing:
-        raise ConfigError(f"worlds: no world file for index {_ranges(missing)} in {wdir} "
-                          f"({len(found)} worlds there, {_ranges(sorted(found))})")
+    ranges = parse_world_selection(selection) if not (
+        isinstance(selection, tuple) and all(isinstance(r, tuple) for r in selection)) \
+        else selection
+    if ranges is None:
+        chosen = sorted(found)
+    else:
+        missing = [a for a, b in ranges if a == b and a not in found]
+        if missing:
+            raise ConfigError(f"worlds: no world file for index {_ranges(missing)} in {wdir} "
+                              f"({len(found)} worlds there: {_ranges(sorted(found))})")
+        chosen = sorted({i for i in found for a, b in ranges if a <= i <= b})
+        empty = [f"{a}-{b}" for a, b in ranges if a < b and not any(a <= i <= b for i in found)]
+        if empty:
+            raise ConfigError(f"worlds: no world file in {', '.join(empty)} in {wdir} "
+                              f"({len(found)} worlds there: {_ranges(sorted(found))})")
     out = []
     for i in chosen:
         pf = pdir / f"path_{i}.npy"
@@ -235,8 +252,9 @@ def _ranges(values: Sequence[int]) -> str:
 
 # --------------------------------------------------------------------------- config
 def default_robot() -> dict[str, Any]:
-    """The scenario ``robot:`` block of the Jackal-sized disc (holonomic)."""
-    return {"radius": JACKAL_RADIUS_M, "max_speed": JACKAL_MAX_SPEED_M_S}
+    """The scenario ``robot:`` block of the Jackal-sized disc (holonomic), facing +y."""
+    return {"radius": JACKAL_RADIUS_M, "max_speed": JACKAL_MAX_SPEED_M_S,
+            "heading": BARN_START_YAW}
 
 
 @dataclass(frozen=True)
@@ -247,8 +265,9 @@ class BarnConfig:
     ----------
     directory : path
         The BARN folder (``worlds/`` and ``path_files/``).
-    worlds : tuple of int or None
-        World indices (None: every world in the folder).
+    worlds : str, list of int or None
+        World indices and inclusive ranges, e.g. ``"0-49,100"`` (None: every
+        world in the folder; see :func:`parse_world_selection`).
     planners : tuple of str
         Online planners (empty: every registered online planner).
     resolution : float
@@ -262,7 +281,7 @@ class BarnConfig:
     """
 
     directory: str
-    worlds: tuple[int, ...] | None = None
+    worlds: Any = None
     planners: tuple[str, ...] = ()
     resolution: float = 0.05
     robot: Mapping[str, Any] = field(default_factory=default_robot)

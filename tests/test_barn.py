@@ -207,3 +207,36 @@ def test_default_subgoal_tolerance_is_at_least_one_move():
     explicit = start_online(get_planner("ref7"), prob, Ref7Params(subgoal_tolerance_m=0.01),
                             0.1, 2.0)
     assert explicit.subgoal_tolerance() == 0.01
+
+
+def test_barn_experiment_file(tmp_path):
+    from pathfuse.studies.barn import load_barn_file
+
+    f = tmp_path / "barn.yaml"
+    f.write_text(f"name: t\ndirectory: {BARN}\nworlds: 17-20\nplanners: [fusion]\n"
+                 "robot: {model: holonomic, radius: 0.3, max_speed: 1.0}\n"
+                 "params: {fusion: {r1_m: 1.0}}\n")
+    cfg, meta = load_barn_file(f)
+    assert meta["name"] == "t" and cfg.planners == ("fusion",)
+    assert [w.index for w in find_worlds(cfg.directory, cfg.worlds)] == [17, 20]
+    assert cfg.robot["model"] == "holonomic" and cfg.robot_radius_m == 0.3
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(f"directory: {BARN}\nplanner: [fusion]\n")
+    with pytest.raises(ConfigError, match=r"bad\.yaml: unknown key 'planner'"):
+        load_barn_file(bad)
+    bad.write_text(f"directory: {BARN}\nresolution: -1\n")
+    with pytest.raises(ConfigError, match=r"bad\.yaml: resolution: must be a number > 0"):
+        load_barn_file(bad)
+    # through the command line, an option overriding the file
+    p = _cli("barn", f, "--planners", "astar", "--worlds", "20", "--workers", 1,
+             "--out", tmp_path / "o")
+    assert p.returncode == 0, p.stderr
+    assert "astar" in p.stdout and "1/1 = 100.0%" in p.stdout and "fusion " not in p.stdout
+
+
+def test_shipped_experiment_file_reads():
+    from pathfuse.studies.barn import load_barn_file
+
+    cfg, meta = load_barn_file(Path(__file__).parents[1] / "experiments" / "barn-jackal.yaml")
+    assert meta["name"] == "barn-jackal" and cfg.robot["model"] == "diff-drive"
+    assert cfg.worlds is None and cfg.resolution == 0.05

@@ -31,26 +31,32 @@ def add_barn_parser(sub: Any) -> None:
         epilog=_fmt("""
 examples:
   pathfuse barn ../shared/data/barn --worlds 0-24 --planners fusion,astar-replan
+  pathfuse barn experiments/barn-jackal.yaml --out barn-jackal
   pathfuse barn tests/data/barn --planners fusion --json > episodes.jsonl
   pathfuse barn ../shared/data/barn --resolution 0.1 --workers 2 --out barn-out
   pathfuse barn ../shared/data/barn --scheduler tcp://10.0.0.5:8786
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    b.add_argument("directory", metavar="DIR",
-                   help="a BARN folder: worlds/ and path_files/ (or the worlds/ folder itself)")
+    b.add_argument("target", metavar="DIR|FILE.yaml",
+                   help="a BARN folder (worlds/ and path_files/, or the worlds/ folder itself) "
+                   "or a BARN experiment file (experiments/barn-*.yaml: folder, worlds, "
+                   "planners, resolution, robot, params); options given override the file")
     b.add_argument("--planners", metavar="A,B,...",
                    help="online planners, comma-separated (default: every online planner)")
     b.add_argument("--worlds", metavar="I,J-K,...",
                    help="world indices and inclusive ranges, e.g. 0-49,100 (default: all)")
-    b.add_argument("--resolution", type=_positive_float, default=0.05,
+    b.add_argument("--resolution", type=_positive_float, default=None,
                    help="grid resolution the worlds are rasterised at, m (default 0.05)")
-    b.add_argument("--robot-radius", type=_positive_float, default=JACKAL_RADIUS_M,
+    b.add_argument("--robot-model", choices=("diff-drive", "holonomic"), default=None,
+                   help="the robot's kinematics (default diff-drive: a Jackal-like base; "
+                   "holonomic: pathfuse's point robot that changes velocity at once)")
+    b.add_argument("--robot-radius", type=_positive_float, default=None,
                    help=f"radius of the disc robot, m (default {JACKAL_RADIUS_M}: the "
                    "Jackal's body fits in it at any heading)")
-    b.add_argument("--max-speed", type=_positive_float, default=JACKAL_MAX_SPEED_M_S,
+    b.add_argument("--max-speed", type=_positive_float, default=None,
                    help=f"speed limit, m/s (default {JACKAL_MAX_SPEED_M_S:g}, the Jackal's)")
-    b.add_argument("--dt", type=_positive_float, default=0.1,
+    b.add_argument("--dt", type=_positive_float, default=None,
                    help="simulation tick, s (default 0.1)")
     b.add_argument("--param", action="append", metavar="PLANNER.KEY=VALUE",
                    help="planner parameter, repeatable (e.g. --param fusion.r1_m=1.0)")
@@ -73,7 +79,7 @@ examples:
 def cmd_barn(args: argparse.Namespace) -> int:
     from pathfuse.cli.args import parse_planner_list, parse_planner_params
     from pathfuse.cli.commands import _study_db, _warm_with_notice
-    from pathfuse.studies.barn import BarnConfig, default_robot, run_barn
+    from pathfuse.studies.barn import BarnConfig, jackal_robot, load_barn_file, run_barn
     from pathfuse.studies.barn_report import (
         json_lines,
         summary_rows,
@@ -81,10 +87,29 @@ def cmd_barn(args: argparse.Namespace) -> int:
         write_barn_outputs,
     )
 
-    robot = {**default_robot(), "radius": args.robot_radius, "max_speed": args.max_speed}
-    cfg = BarnConfig(args.directory, worlds=args.worlds,
-                     planners=parse_planner_list(args.planners), resolution=args.resolution,
-                     robot=robot, dt=args.dt, params=parse_planner_params(args.param))
+    if args.target.lower().endswith((".yaml", ".yml")):
+        base, _ = load_barn_file(args.target)
+    else:
+        base = BarnConfig(args.target)
+    robot = dict(base.robot)
+    if args.robot_model is not None:
+        robot = {**jackal_robot(args.robot_model),
+                 **{k: v for k, v in robot.items() if k != "model"},
+                 "model": args.robot_model}
+    for key, val in (("radius", args.robot_radius), ("max_speed", args.max_speed)):
+        if val is not None:
+            robot[key] = val
+    planners = base.planners if args.planners is None else parse_planner_list(args.planners)
+    from pathfuse.planners.registry import get_planner
+
+    run_names = {get_planner(n).name for n in planners} if planners else set(base.planners)
+    params = {**{k: dict(v) for k, v in base.params.items() if k in run_names},
+              **parse_planner_params(args.param)}
+    cfg = BarnConfig(base.directory,
+                     worlds=base.worlds if args.worlds is None else args.worlds,
+                     planners=planners,
+                     resolution=base.resolution if args.resolution is None else args.resolution,
+                     robot=robot, dt=base.dt if args.dt is None else args.dt, params=params)
     for name in cfg.planners:
         _warm_with_notice(name)
     run = run_barn(cfg, workers=args.workers, scheduler=args.scheduler,

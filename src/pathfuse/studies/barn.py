@@ -62,6 +62,7 @@ __all__ = [
     "JACKAL_MAX_SPEED_M_S", "DWA_BASELINE", "BarnWorld", "BarnConfig", "BarnRun",
     "path_to_world", "reference_length", "barn_metric", "parse_world_selection",
     "find_worlds", "barn_experiment", "run_barn", "episode_record", "trajectory_with_yaw",
+    "load_barn_file", "BARN_FILE_KEYS", "default_robot", "jackal_robot",
 ]
 
 BARN_START = (-2.0, 3.0)
@@ -251,10 +252,18 @@ def _ranges(values: Sequence[int]) -> str:
 
 
 # --------------------------------------------------------------------------- config
+def jackal_robot(model: str = "diff-drive") -> dict[str, Any]:
+    """The scenario ``robot:`` block of a Jackal-sized disc facing +y: a diff-drive base
+    (``model="diff-drive"``, the limits of :data:`pathfuse.robot.DIFF_DRIVE_DEFAULTS`) or
+    pathfuse's holonomic point robot (``"holonomic"``)."""
+    robot: dict[str, Any] = {"model": model, "radius": JACKAL_RADIUS_M,
+                             "max_speed": JACKAL_MAX_SPEED_M_S, "heading": BARN_START_YAW}
+    return robot
+
+
 def default_robot() -> dict[str, Any]:
-    """The scenario ``robot:`` block of the Jackal-sized disc (holonomic), facing +y."""
-    return {"radius": JACKAL_RADIUS_M, "max_speed": JACKAL_MAX_SPEED_M_S,
-            "heading": BARN_START_YAW}
+    """The robot ``pathfuse barn`` runs by default: :func:`jackal_robot` (diff-drive)."""
+    return jackal_robot("diff-drive")
 
 
 @dataclass(frozen=True)
@@ -325,6 +334,60 @@ class BarnConfig:
     @property
     def robot_radius_m(self) -> float:
         return float(self.robot.get("radius", JACKAL_RADIUS_M))
+
+
+BARN_FILE_KEYS = ("name", "description", "directory", "worlds", "planners", "resolution",
+                  "robot", "dt", "params")
+"""The keys of a BARN experiment file (``experiments/barn-*.yaml``)."""
+
+
+def load_barn_file(path: str | os.PathLike[str]) -> tuple[BarnConfig, dict[str, Any]]:
+    """Read a BARN experiment file: the :class:`BarnConfig` it describes, and its
+    ``name``/``description``.
+
+    The file holds the keys of :data:`BARN_FILE_KEYS`::
+
+        name: barn-jackal
+        directory: ../../shared/data/barn     # relative to this file
+        worlds: null                          # or "0-49,100", or [0, 17]
+        planners: [fusion, astar-replan]      # null: every online planner
+        resolution: 0.05
+        dt: 0.1
+        robot: {model: diff-drive, radius: 0.333, max_speed: 2.0, heading: 1.57}
+        params: {fusion: {r1_m: 1.0}}
+
+    Raises
+    ------
+    ConfigError
+        An unknown key, a bad value (the message names the file and the key).
+    MapFormatError
+        A file that is not YAML.
+    """
+    from pathfuse.io.ros import load_yaml_mapping
+
+    p = Path(os.path.expanduser(os.fspath(path)))
+    doc = load_yaml_mapping(p, "BARN experiment")
+    for k in doc:
+        if k not in BARN_FILE_KEYS:
+            raise ConfigError(f"{p}: unknown key {k!r} (allowed: {', '.join(BARN_FILE_KEYS)})")
+    if "directory" not in doc or not isinstance(doc["directory"], str):
+        raise ConfigError(f"{p}: directory: missing (the BARN folder, relative to the file)")
+    d = Path(os.path.expanduser(doc["directory"]))
+    kw: dict[str, Any] = {"directory": str(d if d.is_absolute() else p.parent / d)}
+    for key in ("worlds", "resolution", "dt", "robot", "params"):
+        if doc.get(key) is not None:
+            kw[key] = doc[key]
+    if doc.get("planners") is not None:
+        if not isinstance(doc["planners"], list):
+            raise ConfigError(f"{p}: planners: expected a list of names, got "
+                              f"{doc['planners']!r}")
+        kw["planners"] = tuple(doc["planners"])
+    try:
+        cfg = BarnConfig(**kw)
+    except ConfigError as exc:
+        raise ConfigError(f"{p}: {exc}") from None
+    return cfg, {"name": str(doc.get("name", p.stem)),
+                 "description": str(doc.get("description", ""))}
 
 
 def _scenario(cfg: BarnConfig, w: BarnWorld, digest: str) -> dict[str, Any]:

@@ -46,10 +46,14 @@ def summary_rows(records: Sequence[Mapping[str, Any]],
             k = sum(r["status"] == o for r in recs)
             p, lo, hi = wilson_ci(k, n)
             row.update({o: k, f"{o}_rate": p, f"{o}_ci_low": lo, f"{o}_ci_high": hi})
+        # Student-t intervals, clipped to the values the quantity can take (metric 0..0.5,
+        # time >= 0): a skewed sample of mostly zeros can put the bare interval below 0
         m, lo, hi = mean_ci([float(r["metric"]) for r in recs])
-        row.update({"metric_mean": m, "metric_ci_low": lo, "metric_ci_high": hi})
+        row.update({"metric_mean": m, "metric_ci_low": _clip(lo, 0.0, 0.5),
+                    "metric_ci_high": _clip(hi, 0.0, 0.5)})
         t, tlo, thi = mean_ci([float(r["time_s"]) for r in recs if r["status"] == "success"])
-        row.update({"time_mean_s": t, "time_ci_low_s": tlo, "time_ci_high_s": thi})
+        row.update({"time_mean_s": t, "time_ci_low_s": _clip(tlo, 0.0, math.inf),
+                    "time_ci_high_s": thi})
         detail: dict[str, int] = {}
         for r in recs:
             s = str(r.get("pathfuse_status", ""))
@@ -58,6 +62,10 @@ def summary_rows(records: Sequence[Mapping[str, Any]],
         row["timeout_detail"] = ", ".join(f"{k} {v}" for k, v in sorted(detail.items()))
         rows.append(row)
     return rows
+
+
+def _clip(v: float, lo: float, hi: float) -> float:
+    return v if math.isnan(v) else min(max(v, lo), hi)
 
 
 def _rate(r: Mapping[str, Any], key: str) -> str:
@@ -117,7 +125,8 @@ def markdown_report(run: Any, rows: Sequence[Mapping[str, Any]] | None = None) -
         f"dt {cfg.dt:g} s.  {len(run.records)} episodes in {run.wall_s:.1f} s with "
         f"{run.workers} worker{'s' if run.workers != 1 else ''}.\n\n"
         f"{markdown_table(_table(rows, DWA_BASELINE))}\n\n"
-        "Rates carry 95% Wilson intervals and means 95% Student-t intervals.  The metric "
+        "Rates carry 95% Wilson intervals and means 95% Student-t intervals (clipped to "
+        "the values the quantity can take).  The metric "
         "is the challenge's (success x optimal_time / clip(time, 2 optimal_time, 8 "
         "optimal_time), at most 0.5) averaged over every episode, failures counting 0; the "
         "mean time is over the successful episodes only.  A timeout is every episode that "

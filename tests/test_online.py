@@ -38,7 +38,7 @@ from pathfuse.world import (
 )
 from pathfuse.world.generate import generate_scenarios
 
-PLANNERS = ["fusion", "apf", "astar", "astar-replan", "ref6", "ref7"]
+PLANNERS = ["fusion", "apf", "astar", "astar-replan", "ref6", "ref7", "dwa"]
 HALL = ["." * 15] * 5
 
 

@@ -136,7 +136,7 @@ def register_function(name: str, func: Callable[..., Any], params_cls: type,
     return register(PlannerSpec(name, params_cls, description, function=func))
 
 
-_BUILTIN = ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7")
+_BUILTIN = ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7", "dwa")
 
 
 def planner_names() -> list[str]:
@@ -204,5 +204,5 @@ def _load_builtin() -> None:
     _LOADED = True
     import importlib
 
-    for mod in ("astar", "apf", "fusion", "refs"):
+    for mod in ("astar", "apf", "fusion", "refs", "dwa"):
         importlib.import_module(f"pathfuse.planners.{mod}")

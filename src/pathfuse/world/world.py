@@ -301,7 +301,7 @@ class World:
             dv = v - self.velocity
             lim = rb.max_accel_mps2 * dt
             n = math.hypot(dv[0], dv[1])
-            if n > lim:
+            if n > lim * (1.0 + 1e-9):  # beyond rounding
                 v = self.velocity + dv * (lim / n)
                 clipped = True
         return v, clipped

@@ -240,3 +240,14 @@ def test_shipped_experiment_file_reads():
     cfg, meta = load_barn_file(Path(__file__).parents[1] / "experiments" / "barn-jackal.yaml")
     assert meta["name"] == "barn-jackal" and cfg.robot["model"] == "diff-drive"
     assert cfg.worlds is None and cfg.resolution == 0.05
+
+
+def test_barn_on_a_dask_cluster_equals_the_local_run(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    cfg = BarnConfig(str(BARN), worlds="17", planners=("fusion", "astar"))
+    local = run_barn(cfg, workers=1)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  host="127.0.0.1", dashboard_address=None,
+                                  silence_logs=40) as cluster:
+        remote = run_barn(cfg, scheduler=cluster.scheduler_address, db_path=tmp_path / "d.db")
+    assert local.records == remote.records

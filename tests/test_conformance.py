@@ -61,7 +61,7 @@ def counts_expansions(name):
 def test_all_builtin_planners_are_registered():
     assert {"astar", "astar-replan", "apf", "fusion", "ref6", "ref7"} <= set(NAMES)
     # every built-in planner runs offline and online
-    for name in ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7"):
+    for name in ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7", "dwa"):
         spec = get_planner(name)
         assert spec.offline and spec.online and spec.capabilities() == ("offline", "online")
     assert get_planner("astar-follow").name == "astar"

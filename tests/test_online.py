@@ -38,7 +38,7 @@ from pathfuse.world import (
 )
 from pathfuse.world.generate import generate_scenarios
 
-PLANNERS = ["fusion", "apf", "astar", "astar-replan", "ref6", "ref7"]
+PLANNERS = ["fusion", "apf", "astar", "astar-replan", "ref6", "ref7", "dwa"]
 HALL = ["." * 15] * 5
 
 
@@ -378,8 +378,10 @@ def test_planners_get_the_static_context_and_current_observations_only():
     assert set(inspect.signature(Controller.__init__).parameters) == \
         {"self", "problem", "params", "plan", "dt", "max_speed"}
     assert {f.name for f in dataclasses.fields(Problem)} == \
-        {"grid", "start", "goal", "robot_radius_m", "budget", "start_cell", "goal_cell"}
+        {"grid", "start", "goal", "robot_radius_m", "budget", "start_cell", "goal_cell",
+         "clearance_m", "robot"}
     pb = spy.problem
+    assert pb.robot == sc.robot.to_model() and pb.clearance_m == sc.robot.clearance
     assert pb.grid is sc.grid and pb.start == sc.start and pb.goal == sc.goal
     assert pb.robot_radius_m == sc.robot.radius
     assert (spy.dt, spy.max_speed, spy.online, spy.plan) == (sc.dt, sc.robot.max_speed, True,

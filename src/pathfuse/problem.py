@@ -82,6 +82,14 @@ class Problem:
     start_cell, goal_cell : (int, int)
         ``(row, col)`` of the cells the points lie in (may be outside the
         map: see :meth:`failure`).
+    clearance_m : float
+        The soft safety margin beyond the radius (ours; 0 = off): the global
+        planner pays for coming closer to an obstacle, the controllers keep
+        it where they can (see the README).
+    robot : RobotModel or None
+        The robot's kinematic model (:class:`pathfuse.robot.RobotModel`);
+        None: a holonomic robot (offline, the geometric planners ignore it;
+        ``dwa`` plans with a default diff-drive robot).
     """
 
     grid: GridMap
@@ -91,10 +99,13 @@ class Problem:
     budget: Budget = field(default=_DEFAULT_BUDGET)
     start_cell: tuple[int, int] = (0, 0)
     goal_cell: tuple[int, int] = (0, 0)
+    clearance_m: float = 0.0
+    robot: Any = None
 
     @classmethod
     def create(cls, grid: GridMap, start: object, goal: object, robot_radius_m: float = 0.0,
-               budget: Budget | None = None) -> Problem:
+               budget: Budget | None = None, clearance_m: float = 0.0,
+               robot: Any = None) -> Problem:
         """Check the input once and fix the cells (scalar arithmetic, no numpy per point).
 
         Raises
@@ -103,8 +114,9 @@ class Problem:
             ``grid`` is not a :class:`GridMap`, or ``start``/``goal`` is not a
             pair of finite numbers.
         ConfigError
-            ``robot_radius_m`` is not a finite number >= 0, or ``budget`` is
-            not a :class:`Budget`.
+            ``robot_radius_m`` or ``clearance_m`` is not a finite number >= 0,
+            ``budget`` is not a :class:`Budget`, or ``robot`` is not a
+            :class:`~pathfuse.robot.RobotModel` of radius ``robot_radius_m``.
         """
         if not isinstance(grid, GridMap):
             raise QueryError(f"grid: must be a pathfuse.GridMap, got {type(grid).__name__}")
@@ -125,11 +137,27 @@ class Problem:
             if not ok:
                 raise ConfigError(
                     f"robot_radius_m: must be a finite number >= 0, got {_shown(robot_radius_m)}")
+        c = clearance_m
+        if c != 0.0:
+            if isinstance(c, bool) or not isinstance(c, (int, float)) or not math.isfinite(c) \
+                    or c < 0:
+                raise ConfigError(f"clearance_m: must be a finite number >= 0, got {_shown(c)}")
+            c = float(c)
+        if robot is not None:
+            from pathfuse.robot import RobotModel
+
+            if not isinstance(robot, RobotModel):
+                raise ConfigError(f"robot: must be a pathfuse.RobotModel, got "
+                                  f"{type(robot).__name__}")
+            if robot.radius_m != float(r):
+                raise ConfigError(f"robot: its radius_m ({robot.radius_m:g}) differs from "
+                                  f"robot_radius_m ({float(r):g})")
         ox, oy = grid.origin
         res = grid.resolution
         return cls(grid, s, g, float(r), budget,
                    (math.floor((s[1] - oy) / res), math.floor((s[0] - ox) / res)),
-                   (math.floor((g[1] - oy) / res), math.floor((g[0] - ox) / res)))
+                   (math.floor((g[1] - oy) / res), math.floor((g[0] - ox) / res)),
+                   c, robot)
 
     def failure(self) -> tuple[Status, str] | None:
         """``(status, message)`` when the start or goal cannot be planned from, else None.
@@ -207,4 +235,4 @@ class Problem:
         res = self.grid.resolution
         return Problem(self.grid, start, self.goal, self.robot_radius_m, self.budget,
                        (math.floor((start[1] - oy) / res), math.floor((start[0] - ox) / res)),
-                       self.goal_cell)
+                       self.goal_cell, self.clearance_m, self.robot)

@@ -29,7 +29,7 @@ KEY_VERSION = 1
 
 GENERATED_FAMILIES = ("paper", "random")
 """Map families drawn from a seed; without an explicit seed they take the run's."""
-FILE_FAMILIES = ("movingai", "ros", "image", "npy")
+FILE_FAMILIES = ("movingai", "ros", "image", "npy", "gazebo")
 """Map families read from a file (path relative to the experiment file)."""
 INLINE_FAMILIES = ("rows",)
 """Maps written inline in the experiment."""

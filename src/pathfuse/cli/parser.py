@@ -17,6 +17,7 @@ from pathfuse.cli.args import (
     _positive_float,
     _positive_int,
 )
+from pathfuse.cli.barn import add_barn_parser
 from pathfuse.cli.commands import (
     cmd_bench,
     cmd_dynamic,
@@ -225,6 +226,8 @@ examples:
                     help="no progress display (default on stderr: a live bar on a terminal, a "
                     "few plain lines otherwise)")
     dy.set_defaults(func=cmd_dynamic)
+
+    add_barn_parser(sub)
 
     b = sub.add_parser(
         "bench",

@@ -12,6 +12,8 @@ source                 read by
 ``*.jpg`` ``*.jpeg``
 ``*.bmp``
 ``*.npy``              :func:`~pathfuse.io.image.read_npy` (``resolution`` needed)
+``*.world`` ``*.sdf``  :func:`~pathfuse.io.gazebo.read_gazebo_world` (Gazebo SDF,
+(``.gz`` too)          plain or gzipped; ``resolution`` default 0.05 m)
 =====================  ===========================================================
 
 Examples
@@ -34,6 +36,7 @@ from typing import Any
 
 from pathfuse.generate import paper_map, random_map
 from pathfuse.grid import GridMap
+from pathfuse.io.gazebo import GAZEBO_SUFFIXES, is_gazebo_path, read_gazebo_world
 from pathfuse.io.image import IMAGE_SUFFIXES, read_image, read_npy
 from pathfuse.io.inline import read_rows_yaml
 from pathfuse.io.movingai import read_movingai
@@ -43,10 +46,10 @@ from pathfuse.validate import short as _shown
 
 __all__ = ["load_map", "map_from_spec", "SUPPORTED_SUFFIXES", "SPEC_SOURCES"]
 
-SUPPORTED_SUFFIXES = (".map", ".yaml", ".yml", *IMAGE_SUFFIXES, ".npy")
+SUPPORTED_SUFFIXES = (".map", ".yaml", ".yml", *IMAGE_SUFFIXES, ".npy", *GAZEBO_SUFFIXES)
 """File name endings :func:`load_map` reads."""
 
-SPEC_SOURCES = ("random", "paper", "movingai", "ros", "image", "npy", "rows")
+SPEC_SOURCES = ("random", "paper", "movingai", "ros", "image", "npy", "rows", "gazebo")
 """The source keys of a map spec; exactly one must be present."""
 
 _SPEC_EXTRA = {
@@ -57,6 +60,7 @@ _SPEC_EXTRA = {
     "image": ("resolution", "origin", "threshold", "negate", "name"),
     "npy": ("resolution", "origin", "name"),
     "rows": ("resolution", "origin", "name"),
+    "gazebo": ("resolution", "bounds", "margin", "name"),
 }
 _RANDOM_KEYS = ("size", "resolution", "obstacles", "density", "seed", "origin",
                 "keep_free", "connect")
@@ -74,6 +78,7 @@ def load_map(
     origin: tuple[float, float] | None = None,
     seed: int | None = None,
     unknown: str = "occupied",
+    bounds: tuple[float, float, float, float] | None = None,
 ) -> GridMap:
     """Load a map from a name or a file, choosing the reader by the file's ending.
 
@@ -93,6 +98,9 @@ def load_map(
         Seed of the generated ``"paper"`` map (default 0); ignored for files.
     unknown : {"occupied", "free"}
         What unknown cells of a ROS map become (see :mod:`pathfuse.io.ros`).
+    bounds : (x_min, y_min, x_max, y_max), optional
+        Extent of a Gazebo world's grid in metres (default: its obstacles
+        grown by 1 m); refused for other sources.
 
     Raises
     ------
@@ -116,6 +124,14 @@ def load_map(
         raise ConfigError(f"a map is 'paper' or a file path, got {_shown(spec)}")
     path = Path(os.path.expanduser(os.fspath(spec)))
     suffix = path.suffix.lower()
+    if is_gazebo_path(path):
+        if origin is not None:
+            raise ConfigError(f"{path}: a Gazebo world's grid is placed by bounds=(x_min, "
+                              f"y_min, x_max, y_max), not origin={origin!r}")
+        return read_gazebo_world(path, 0.05 if resolution is None else resolution,
+                                 bounds=bounds)
+    if bounds is not None:
+        raise ConfigError(f"{path}: bounds= applies to Gazebo worlds only")
     if suffix not in SUPPORTED_SUFFIXES:
         raise MapFormatError(
             f"{path}: unsupported map file type {_shown(suffix or '(no extension)')}; "
@@ -201,6 +217,7 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
         {image: FILE.png, resolution: 0.05, origin: [0, 0], threshold: 0.5, negate: false}
         {npy: FILE.npy, resolution: 0.1, origin: [0, 0]}
         {rows: ["....", ".##."], resolution: 1.0, origin: [0, 0]}
+        {gazebo: FILE.world.gz, resolution: 0.05, bounds: [x0, y0, x1, y1], margin: 1.0}
 
     Every source also takes ``name`` except ``paper``.  A string spec is
     passed to :func:`load_map` (relative paths against ``base_dir``).
@@ -272,6 +289,9 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
         return read_rows_yaml(doc)
 
     path = _resolve(base, value, src)
+    if src == "gazebo":
+        return read_gazebo_world(path, spec.get("resolution", 0.05), bounds=spec.get("bounds"),
+                                 margin_m=spec.get("margin", 1.0), name=name)
     if src == "movingai":
         return read_movingai(path, resolution=spec.get("resolution", 1.0),
                              origin=spec.get("origin", (0.0, 0.0)), name=name)

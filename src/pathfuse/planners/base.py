@@ -73,6 +73,10 @@ class Observed(Protocol):
     def velocity(self) -> np.ndarray: ...
     @property
     def obstacles(self) -> Any: ...  # positions (M, 2), velocities (M, 2), radii (M,), len()
+    @property
+    def heading(self) -> float: ...
+    @property
+    def command(self) -> np.ndarray: ...
 
 
 @dataclass
@@ -118,6 +122,9 @@ class Controller:
     search_budget: ClassVar[bool] = False
     """Whether ``Budget.max_iterations`` caps the global search (``astar``) rather than the
     controller's moves."""
+    native_unicycle: ClassVar[bool] = False
+    """Whether :meth:`act` answers ``(v, omega)`` itself on a diff-drive robot (``dwa``);
+    otherwise :meth:`command` converts its velocity (:mod:`pathfuse.planners.drive`)."""
 
     def __init__(self, problem: Problem, params: Any, plan: Any = None, *,
                  dt: float | None = None, max_speed: float | None = None) -> None:
@@ -149,6 +156,20 @@ class Controller:
     def act(self, obs: Observed) -> np.ndarray:  # pragma: no cover - abstract
         """The velocity ``(vx, vy)`` for this tick."""
         raise NotImplementedError
+
+    def command(self, obs: Observed) -> np.ndarray:
+        """The action for this tick in the robot's terms: :meth:`act`'s velocity for a
+        holonomic robot, ``(v, omega)`` for a diff-drive one (converted by
+        :func:`pathfuse.planners.drive.to_unicycle` unless the controller plans in
+        ``(v, omega)`` itself)."""
+        a = self.act(obs)
+        rb = self.problem.robot
+        if rb is None or not rb.is_diff_drive or self.native_unicycle:
+            return a
+        from pathfuse.planners.drive import to_unicycle
+
+        return to_unicycle(self.problem, rb, float(self.dt), obs,  # type: ignore[arg-type]
+                           a)
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:

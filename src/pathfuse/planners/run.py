@@ -13,6 +13,7 @@ compilation.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -25,7 +26,7 @@ from pathfuse.planners.registry import PlannerSpec
 from pathfuse.problem import Problem
 from pathfuse.result import PlanResult, Status, path_length
 
-__all__ = ["solve", "start_online", "warm", "Stopped"]
+__all__ = ["solve", "start_online", "warm", "Stopped", "PlanInfo"]
 
 _WARM: set[str] = set()
 
@@ -86,7 +87,9 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
             return PlanResult(gp.status, time_s=gp.time_s, planner=spec.name,
                               expansions=gp.expansions, message=msg, info=_astar_info(gp))
     out = ctrl_cls(problem, params, gp).run(deadline)
-    info = {**_astar_info(gp), **out.info} if not ctrl_cls.search_budget else dict(out.info)
+    info = PlanInfo({**_astar_info(gp), **out.info} if not ctrl_cls.search_budget
+                    else out.info)
+    info.bind(problem.grid, out.path, problem.robot_radius_m)
     length = out.length_m if out.length_m is not None else path_length(out.path)
     return PlanResult(out.status, out.path, length, (gp.time_s if gp else 0.0) + out.time_s,
                       spec.name, gp.expansions if gp else 0, out.steps, out.message, info)
@@ -102,6 +105,32 @@ def _global(spec: PlannerSpec, problem: Problem, params: Any,
     from pathfuse.planners.anyangle import plan_any_angle
 
     return plan_any_angle(str(spec.global_planner), problem, params, max_expansions)
+
+
+class PlanInfo(dict):
+    """``PlanResult.info`` of the registered planners: a dict that also answers
+    ``info["min_clearance_m"]``, the least gap between the robot disc along the path and
+    any occupied square (metres; ``inf`` on an empty map), computed on first access by
+    :func:`pathfuse.metrics.min_clearance` (independently of the planner), so that a
+    caller who never asks pays nothing.  It pickles as a plain dict."""
+
+    _bound: tuple[Any, np.ndarray, float] | None = None
+
+    def bind(self, grid: Any, path: np.ndarray, radius_m: float) -> None:
+        self._bound = (grid, path, float(radius_m))
+
+    def __missing__(self, key: Any) -> Any:
+        if key != "min_clearance_m" or self._bound is None:
+            raise KeyError(key)
+        from pathfuse.metrics import min_clearance
+
+        grid, path, r = self._bound
+        v = min_clearance(grid, path) - r if path.shape[0] else math.nan
+        self[key] = v
+        return v
+
+    def __reduce__(self) -> Any:
+        return (dict, (dict(self),))
 
 
 def _renamed(res: PlanResult, name: str) -> PlanResult:

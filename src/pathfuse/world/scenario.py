@@ -75,6 +75,7 @@ from pathfuse.world.obstacles import (
     PatrolObstacle,
     RandomWalkObstacle,
 )
+from pathfuse.world.robot import RobotSpec, parse_robot
 
 __all__ = [
     "Scenario",
@@ -97,7 +98,6 @@ SCENARIO_KEYS = ("name", "description", "map", "start", "goal", "robot", "dt", "
                  "goal_tolerance", "stall_time", "stall_radius", "seed", "obstacles", "planner")
 """The keys a scenario file may have."""
 _REQUIRED = ("map", "start", "goal")
-_ROBOT_KEYS = ("radius", "max_speed", "sensing_radius")
 _LINEAR_KEYS = ("position", "velocity", "radius")
 _PATROL_KEYS = ("waypoints", "speed", "radius", "loop")
 _RW_OUTER_KEYS = ("random_walk", "radius")
@@ -106,26 +106,6 @@ _PLANNER_KEYS = ("name", "params")
 
 
 # ---------------------------------------------------------------------- specs
-@dataclass(frozen=True)
-class RobotSpec:
-    """The robot: a disc with a speed limit and a sensing range.
-
-    Attributes
-    ----------
-    radius : float
-        Disc radius in metres (>= 0).
-    max_speed : float
-        Speed limit in m/s (> 0); commanded velocities are clipped to it.
-    sensing_radius : float
-        Moving discs whose surface comes within this many metres of the
-        robot's centre appear in the observation (> 0).
-    """
-
-    radius: float = 0.2
-    max_speed: float = 1.0
-    sensing_radius: float = 3.0
-
-
 @dataclass(frozen=True)
 class PlannerChoice:
     """An online planner's registry name and its parameter overrides."""
@@ -301,6 +281,15 @@ def _check_scene(sc: Scenario) -> None:
             f"the robot and {len(sc.obstacles)} moving discs ({steps:.3g} body-ticks) is above "
             f"the limit of {cap} (MAX_TICKS; set the environment variable "
             f"{env_name('MAX_TICKS')} to raise it)")
+    if not isinstance(sc.robot, RobotSpec):
+        raise ScenarioError(f"robot: must be a RobotSpec, got {type(sc.robot).__name__}")
+    if sc.robot.model == "holonomic" and sc.robot.min_speed != 0:
+        raise ScenarioError(f"robot.min_speed: only a diff-drive robot reverses; got "
+                            f"{sc.robot.min_speed!r} for a holonomic one")
+    try:
+        sc.robot.to_model()  # the model and its limits
+    except ConfigError as exc:
+        raise ScenarioError(str(exc)) from None
     r = sc.robot.radius
     _check_point(sc.grid, sc.start, r, "start", "the robot")
     _check_point(sc.grid, sc.goal, r, "goal", "the robot")
@@ -335,8 +324,9 @@ def _check_scene(sc: Scenario) -> None:
 # the checks of pathfuse.validate, raising ScenarioError
 
 
-def _num(v: Any, key: str, *, gt: float | None = None, ge: float | None = None) -> float:
-    return validate.number(v, key, gt=gt, ge=ge, error=ScenarioError)
+def _num(v: Any, key: str, *, gt: float | None = None, ge: float | None = None,
+         le: float | None = None) -> float:
+    return validate.number(v, key, gt=gt, ge=ge, le=le, error=ScenarioError)
 
 
 def _int(v: Any, key: str, *, ge: int = 0) -> int:
@@ -360,19 +350,6 @@ def _mapping(v: Any, key: str, allowed: tuple[str, ...], what: str = "a mapping"
 
 
 # ---------------------------------------------------------------------- section parsers
-def _parse_robot(v: Any) -> RobotSpec:
-    if v is None:
-        return RobotSpec()
-    m = _mapping(v, "robot", _ROBOT_KEYS)
-    d = RobotSpec()
-    return RobotSpec(
-        radius=_num(m.get("radius", d.radius), "robot.radius", ge=0),
-        max_speed=_num(m.get("max_speed", d.max_speed), "robot.max_speed", gt=0),
-        sensing_radius=_num(m.get("sensing_radius", d.sensing_radius), "robot.sensing_radius",
-                            gt=0),
-    )
-
-
 def _parse_obstacle(v: Any, index: int) -> ObstacleSpec:
     key = f"obstacles[{index}]"
     if not isinstance(v, Mapping):
@@ -500,7 +477,7 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
         grid=grid,
         start=_point(doc["start"], "start"),
         goal=_point(doc["goal"], "goal"),
-        robot=_parse_robot(doc.get("robot")),
+        robot=parse_robot(doc.get("robot"), ScenarioError),
         dt=_num(doc.get("dt", 0.1), "dt", gt=0),
         time_limit=_num(doc.get("time_limit", 60.0), "time_limit", gt=0),
         goal_tolerance=_num(doc.get("goal_tolerance", 0.25), "goal_tolerance", gt=0),

@@ -119,7 +119,7 @@ def create_app(*, map_folders: list[tuple[str, Path]] | None = None, limits: Lim
 
     async def compute(fn: Callable[..., Any], *args: Any) -> Response:
         try:
-            with anyio.fail_after(limits.time_budget_s + 5.0):
+            with anyio.fail_after(limits.time_budget_s + limits.grace_s):
                 data = await anyio.to_thread.run_sync(partial(fn, *args), limiter=limiter,
                                                       abandon_on_cancel=True)
         except TimeoutError:

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.grid import GridMap
-from pathfuse.result import ConfigError, MapError, MapFormatError, PathfuseError
+from pathfuse.result import ConfigError, MapFormatError, PathfuseError
 
 __all__ = [
     "Limits",
@@ -80,6 +80,10 @@ class Limits:
         Ticks of one simulated episode.
     max_discs : int
         Moving discs of one scenario.
+    grace_s : float
+        How long past ``time_budget_s`` the server waits for a computation
+        before it answers 503 (a planner stops at its budget, but the
+        metrics and layers around it take a little longer).
     """
 
     max_cells: int = 2048 * 2048
@@ -88,6 +92,7 @@ class Limits:
     time_budget_s: float = 20.0
     max_ticks: int = 20000
     max_discs: int = 64
+    grace_s: float = 5.0
 
 
 # --------------------------------------------------------------------------- JSON form
@@ -519,8 +524,6 @@ def read_upload(files: list[tuple[str, bytes]], limits: Limits,
     One map file, a ROS YAML with its image, or a ``.zip`` of them.  Images and
     ``.npy`` need ``resolution``.  Sizes and cell counts are checked first.
     """
-    from pathfuse.io import load_map
-
     if not files:
         raise MapFormatError("no file uploaded")
     if len(files) > 4:
@@ -528,30 +531,40 @@ def read_upload(files: list[tuple[str, bytes]], limits: Limits,
                             "image (or one .zip)")
     with tempfile.TemporaryDirectory(prefix="pathfuse-upload-") as tmp:
         folder = Path(tmp)
-        paths: list[Path] = []
-        for i, (name, data) in enumerate(files):
-            safe = _safe_name(name, i)
-            if safe.lower().endswith(".zip"):
-                paths += _unzip(data, folder, limits, safe)
-            else:
-                target = folder / safe
-                target.write_bytes(data)
-                paths.append(target)
-        path = _pick_map_file(paths)
-        for p in paths:
-            _check_header(p, limits)
-        if path.suffix.lower() in (".yaml", ".yml"):
-            _check_ros_image(path, folder)
-        kwargs: dict[str, Any] = {}
-        if resolution is not None and path.suffix.lower() not in (".yaml", ".yml"):
-            kwargs["resolution"] = resolution
         try:
-            grid = load_map(path, **kwargs)
-        except (PathfuseError, MapError) as exc:
-            # the temporary folder is the server's business: name the file as uploaded
-            raise type(exc)(str(exc).replace(str(folder) + os.sep, "").replace(str(folder), "")
-                            ) from None
+            grid, name = _read_files(files, folder, limits, resolution)
+        except ApiError:
+            raise
+        except PathfuseError as exc:
+            # the temporary folder is the server's business: name the files as uploaded
+            raise type(exc)(str(exc).replace(str(folder) + os.sep, "")
+                            .replace(str(folder), "")) from None
         except (ValueError, OSError, MemoryError) as exc:
-            raise MapFormatError(f"{path.name}: cannot read this map ({exc})") from None
-    _cells_ok(grid.width, grid.height, limits, path.name)
+            msg = str(exc).replace(str(folder) + os.sep, "").replace(str(folder), "")
+            raise MapFormatError(f"cannot read this map ({msg})") from None
+    _cells_ok(grid.width, grid.height, limits, name)
     return grid
+
+
+def _read_files(files: list[tuple[str, bytes]], folder: Path, limits: Limits,
+                resolution: float | None) -> tuple[GridMap, str]:
+    from pathfuse.io import load_map
+
+    paths: list[Path] = []
+    for i, (name, data) in enumerate(files):
+        safe = _safe_name(name, i)
+        if safe.lower().endswith(".zip"):
+            paths += _unzip(data, folder, limits, safe)
+        else:
+            target = folder / safe
+            target.write_bytes(data)
+            paths.append(target)
+    path = _pick_map_file(paths)
+    for p in paths:
+        _check_header(p, limits)
+    if path.suffix.lower() in (".yaml", ".yml"):
+        _check_ros_image(path, folder)
+    kwargs: dict[str, Any] = {}
+    if resolution is not None and path.suffix.lower() not in (".yaml", ".yml"):
+        kwargs["resolution"] = resolution
+    return load_map(path, **kwargs), path.name

@@ -438,7 +438,7 @@ canvas.addEventListener("pointerup", (e) => {
   drag = null;
   if (d.kind === "start" || d.kind === "goal" || d.kind === "paint") edited();
   if (d.kind === "disc") {
-    const r = Math.max(0.3, 2 * state.map.resolution);
+    const r = Math.min(Math.max(0.6 * state.map.resolution, 0.2), 1.0);
     scene.add({ position: [round(d.p[0]), round(d.p[1])],
                 velocity: [round(d.q[0] - d.p[0]), round(d.q[1] - d.p[1])], radius: round(r) });
   }

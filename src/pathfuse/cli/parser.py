@@ -26,6 +26,7 @@ from pathfuse.cli.commands import (
     cmd_planners,
     cmd_report,
     cmd_scen,
+    cmd_serve,
     cmd_simulate,
 )
 from pathfuse.result import PathfuseError
@@ -323,7 +324,48 @@ with one configuration; by default R_length is against the experiment's own refe
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=cmd_planners)
 
+    _add_serve(sub)
     return parser
+
+
+def _add_serve(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse serve``: the planning playground in the browser."""
+    w = sub.add_parser(
+        "serve", help="the planning playground in the browser (pip install \"pathfuse[web]\")",
+        description="Start a local web app: draw or load a map, drag start and goal, run "
+        "any registered planners side by side, look at the potential field, the A* closed "
+        "set and the c-space, and play moving-obstacle episodes.  Its JSON API is "
+        "documented in the README.  Binds to 127.0.0.1 unless --host says otherwise.",
+        epilog=_fmt("""
+examples:
+  pathfuse serve --open
+  pathfuse serve --port 8080 --maps ../shared/data/movingai
+  pathfuse serve --host 0.0.0.0 --port 8000     # reachable from other machines
+
+Needs the web extra: pip install "pathfuse[web]".
+"""),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    w.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    w.add_argument("--port", type=_nonneg_int, default=8000, help="port (default 8000)")
+    w.add_argument("--open", action="store_true", help="open the page in a web browser")
+    w.add_argument("--maps", action="append", metavar="DIR",
+                   help="a folder of maps and scenario files to offer, repeatable (default: "
+                   "examples/ and tests/data/ of the source tree, when present)")
+    w.add_argument("--budget", type=_positive_float, default=20.0,
+                   help="seconds one request may compute (default 20)")
+    w.add_argument("--max-cells", type=_positive_int, default=2048 * 2048,
+                   help="cells of any map (default 4194304 = 2048 x 2048)")
+    w.add_argument("--max-upload-mb", type=_positive_int, default=32,
+                   help="size of an upload in MiB (default 32)")
+    w.add_argument("--workers", type=_positive_int, default=2,
+                   help="requests computed at once, each in a thread (default 2)")
+    w.add_argument("--no-warm", action="store_true",
+                   help="do not compile the planners' kernels when the server starts")
+    w.add_argument("--log-level", default="warning",
+                   choices=["critical", "error", "warning", "info", "debug"],
+                   help="uvicorn's log level (default warning)")
+    w.set_defaults(func=cmd_serve)
 
 
 _POINT_OPTIONS = ("--start", "--goal")

@@ -83,8 +83,8 @@ from typing import Any
 import numpy as np
 
 from pathfuse.result import PathfuseError, QueryError
-from pathfuse.validate import short as _shown
 from pathfuse.sweep import arc_disc_gaps, arc_static_distance, unicycle_pose
+from pathfuse.validate import short as _shown
 from pathfuse.world.geometry import (
     disc_sweep_gaps,
     point_segment_distance,

@@ -419,3 +419,45 @@ def test_empty_scen_is_an_error(tmp_path):
     p = _write(tmp_path, "e.scen", "version 1\n")
     with pytest.raises(MapFormatError, match="holds no problem line"):
         read_scen(p, read_movingai(DATA / "movingai" / "den312d.map"))
+
+
+# ------------------------------------------- the memory-hungry calls, under a memory limit
+_HUNGRY = {
+    "inflate": "from pathfuse.grid import GridMap\n"
+               "assert GridMap.from_rows(['..#.', '....', '....']).inflate(1e9).occupied.all()",
+    "cspace": "import pathfuse\nfrom pathfuse.grid import GridMap\n"
+              "g = GridMap.from_rows(['....'] * 3)\n"
+              "print(pathfuse.plan(g, (0.5, 0.5), (3.5, 0.5), robot_radius_m=1e5).status.name)",
+    "random_map": "from pathfuse.generate import random_map\n"
+                  "random_map(size_m=1e7, resolution=1.0, obstacles=1)",
+    "seeds": "from pathfuse.bench.keys import parse_seeds\nparse_seeds('0:1000000000')",
+    "bomb": f"from pathfuse.safeyaml import load_yaml\nload_yaml({bomb()!r}, 'b.yaml')",
+    "huge_budget": "import pathfuse\nfrom pathfuse.grid import GridMap\n"
+                   "g = GridMap.from_rows(['......'] * 3)\n"
+                   "b = pathfuse.Budget(max_iterations=10**30)\n"
+                   "print(pathfuse.plan(g, (0.5, 1.5), (5.5, 1.5), 'apf', budget=b).status.name)",
+}
+
+
+@pytest.mark.parametrize("case", sorted(_HUNGRY))
+def test_hungry_calls_stay_within_a_memory_limit(case):
+    """Each call runs in a child limited to 2 GB of address space (the unchecked versions
+    took 4-17 GB) and 60 s: it must end in a pathfuse error or a result, never MemoryError."""
+    import resource
+    import subprocess
+    import sys
+
+    def limit_memory():  # pragma: no cover - runs in the child
+        resource.setrlimit(resource.RLIMIT_AS, (2 * 1024**3, 2 * 1024**3))
+
+    code = ("import sys\nfrom pathfuse import PathfuseError\ntry:\n"
+            + "".join("    " + ln + "\n" for ln in _HUNGRY[case].splitlines())
+            + "except PathfuseError as exc:\n    print('error:', exc)\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=60, preexec_fn=limit_memory)
+    assert p.returncode == 0, p.stderr
+    assert "Traceback" not in p.stderr
+    expected = {"inflate": "", "cspace": "START_OCCUPIED", "random_map": "error: random map",
+                "seeds": "error: seeds: a seed count", "bomb": "error: b.yaml",
+                "huge_budget": "SUCCESS"}[case]
+    assert expected in p.stdout, p.stdout

@@ -330,7 +330,10 @@ def _num(v: Any, key: str, *, gt: float | None = None, ge: float | None = None,
 
 
 def _int(v: Any, key: str, *, ge: int = 0) -> int:
-    return validate.integer(v, key, ge=ge, le=MAX_SEED, error=ScenarioError)
+    out = validate.integer(v, key, ge=ge, error=ScenarioError)
+    if out > MAX_SEED:  # seeds are stored as SQLite (64-bit) integers
+        raise ScenarioError(f"{key}: must be an integer in [0, 2**63), got {_shown(out)}")
+    return out
 
 
 def _bool(v: Any, key: str) -> bool:

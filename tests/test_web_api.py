@@ -543,7 +543,7 @@ def test_scenario_uploads(client):
     bad = (b"map: paper\nstart: [1, 1]\ngoal: [11, 11]\nobstacles:\n"
            b"  - {position: [6, 2], speed: x\n")
     r = client.post("/api/scenarios", files={"file": ("bad.yaml", bad)})
-    assert r.status_code == 400 and r.json()["error"].startswith("bad.yaml, line ")
+    assert r.status_code == 400 and r.json()["error"].startswith("bad.yaml: line ")
     assert "pathfuse-scenario" not in r.json()["error"]  # no server path in the message
     ref = b"map: {movingai: /etc/passwd}\nstart: [1, 1]\ngoal: [2, 2]\n"
     r = client.post("/api/scenarios", files={"file": ("ref.yaml", ref)})

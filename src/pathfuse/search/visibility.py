@@ -238,12 +238,13 @@ def _vis_kernel(occ, q, xs, ys, ts, g, parent, closed, hkey, hnode, meta, max_ex
     return 1, hkey, hnode
 
 
-_CORNERS: dict[tuple[int, bytes, float], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+_CORNERS: dict[tuple[tuple[int, ...], bytes, float],
+               tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 
 def _corners_cached(occ: np.ndarray, q: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The convex corners of a map, cached per (map content, growth) for repeated queries."""
-    key = (occ.shape[1], np.packbits(occ).tobytes(), q)
+    key = (tuple(occ.shape), np.packbits(occ).tobytes(), q)
     hit = _CORNERS.get(key)
     if hit is None:
         if len(_CORNERS) >= 16:

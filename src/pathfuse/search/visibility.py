@@ -20,8 +20,10 @@ Definition (what ``shortest`` computes, exactly)
       ``radius + MARGIN_FRAC * res``, which every pathfuse move keeps) also
       keeps L-infinity distance ``rho`` (``1/sqrt(2) > 1/2``), so no pathfuse
       planner's path is shorter, for a point robot;
-    * for a point robot the length exceeds ``L*`` by at most ``3 rho`` per
-      corner (``1.5e-6`` cells).
+    * for a point robot the length exceeds ``L*`` by at most ``2 sqrt(2) rho``
+      (under ``1.5e-6`` cells) per point where the limit path touches an
+      obstacle (moving such a point by ``sqrt(2) rho`` lengthens its two
+      segments by at most that much each).
 
     For a disc robot of radius ``r`` the grown squares are the configuration
     space of an axis-aligned *square* robot of half-side ``r``, which contains

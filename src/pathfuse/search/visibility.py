@@ -79,55 +79,67 @@ def growth_cells(robot_radius_m: float, res: float) -> float:
     return robot_radius_m / res + 0.5 * MARGIN_FRAC
 
 
+@njit(cache=True, inline="always")
+def _corner(i, j, k, q):
+    """Corner ``k`` of the square of cell ``(i, j)`` grown by ``q``: ``(x, y, type)``."""
+    if k == 0:
+        return j - q, i - q, 1
+    if k == 1:
+        return j + 1 + q, i + 1 + q, 1
+    if k == 2:
+        return j + 1 + q, i - q, -1
+    return j - q, i + 1 + q, -1
+
+
+@njit(cache=True, inline="always")
+def _is_convex(occ, i, j, cx, cy, q, win):
+    """Whether the corner ``(cx, cy)`` of cell ``(i, j)``'s grown square lies in the inset map
+    and in no other grown square."""
+    h, w = occ.shape
+    if not (q <= cx <= w - q and q <= cy <= h - q):
+        return False
+    for i2 in range(max(i - win, 0), min(i + win, h - 1) + 1):
+        for j2 in range(max(j - win, 0), min(j + win, w - 1) + 1):
+            if occ[i2, j2] and (i2 != i or j2 != j) and \
+                    j2 - q <= cx <= j2 + 1 + q and i2 - q <= cy <= i2 + 1 + q:
+                return False
+    return True
+
+
 @njit(cache=True)
 def convex_corners(occ, q):
     """Convex corners of the squares grown by ``q`` cells (cell units, origin 0).
 
     Returns ``(x, y, t)``: coordinates and the tangency type (``+1``:
     bottom-left or top-right corner, a tangent line has ``dx * dy <= 0``;
-    ``-1``: bottom-right or top-left, ``dx * dy >= 0``).
+    ``-1``: bottom-right or top-left, ``dx * dy >= 0``).  Two passes (count,
+    then fill), so the arrays hold exactly the corners.
     """
     h, w = occ.shape
-    n = 0
-    for i in range(h):
-        for j in range(w):
-            if occ[i, j]:
-                n += 1
-    xs = np.empty(4 * n)
-    ys = np.empty(4 * n)
-    ts = np.empty(4 * n, dtype=np.int64)
     win = int(math.ceil(2.0 * q)) + 1
     m = 0
     for i in range(h):
         for j in range(w):
-            if not occ[i, j]:
-                continue
-            for k in range(4):
-                if k == 0:
-                    cx, cy, t = j - q, i - q, 1
-                elif k == 1:
-                    cx, cy, t = j + 1 + q, i + 1 + q, 1
-                elif k == 2:
-                    cx, cy, t = j + 1 + q, i - q, -1
-                else:
-                    cx, cy, t = j - q, i + 1 + q, -1
-                if not (q <= cx <= w - q and q <= cy <= h - q):
-                    continue
-                inside = False
-                for i2 in range(max(i - win, 0), min(i + win, h - 1) + 1):
-                    for j2 in range(max(j - win, 0), min(j + win, w - 1) + 1):
-                        if occ[i2, j2] and (i2 != i or j2 != j) and \
-                                j2 - q <= cx <= j2 + 1 + q and i2 - q <= cy <= i2 + 1 + q:
-                            inside = True
-                            break
-                    if inside:
-                        break
-                if not inside:
-                    xs[m] = cx
-                    ys[m] = cy
-                    ts[m] = t
-                    m += 1
-    return xs[:m], ys[:m], ts[:m]
+            if occ[i, j]:
+                for k in range(4):
+                    cx, cy, t = _corner(i, j, k, q)
+                    if _is_convex(occ, i, j, cx, cy, q, win):
+                        m += 1
+    xs = np.empty(m)
+    ys = np.empty(m)
+    ts = np.empty(m, dtype=np.int64)
+    m = 0
+    for i in range(h):
+        for j in range(w):
+            if occ[i, j]:
+                for k in range(4):
+                    cx, cy, t = _corner(i, j, k, q)
+                    if _is_convex(occ, i, j, cx, cy, q, win):
+                        xs[m] = cx
+                        ys[m] = cy
+                        ts[m] = t
+                        m += 1
+    return xs, ys, ts
 
 
 @njit(cache=True)

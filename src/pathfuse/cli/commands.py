@@ -426,14 +426,22 @@ def cmd_report(args: argparse.Namespace) -> int:
     n_exp, n_cfg = len({r["experimentid"] for r in study.runs}), len(study.config_ids())
     print(f"{args.db}: {len(study.runs)} runs, {n_exp} map entr{'y' if n_exp == 1 else 'ies'}, "
           f"{n_cfg} planner configuration{'' if n_cfg == 1 else 's'}")
-    head = ("scope", "configuration", "runs", "success", "errors", "length mean", "R_length")
+    excess = any(r.get("excess_pairs") for r in shown)
+    head: tuple[str, ...] = ("scope", "configuration", "runs", "success", "errors",
+                             "length mean", "R_length")
+    if excess:
+        head += ("excess over shortest",)
     table = [head]
     for r in shown:
         rl = "n/a" if not r["r_length_pairs"] else \
             f"{100 * r['r_length_mean']:+.2f}% (n={r['r_length_pairs']})"
         lm = "n/a" if not r["length_n"] else f"{r['length_mean_m']:.3f} m"
-        table.append((r["scope"], r["config"], str(r["runs"]),
-                      f"{100 * r['success_rate']:.1f}%", str(r["errors"]), lm, rl))
+        line: tuple[str, ...] = (r["scope"], r["config"], str(r["runs"]),
+                                 f"{100 * r['success_rate']:.1f}%", str(r["errors"]), lm, rl)
+        if excess:
+            line += ("-" if not r.get("excess_pairs") else
+                     f"{100 * r['excess_mean']:+.2f}% (n={r['excess_pairs']})",)
+        table.append(line)
     widths = [max(len(row[i]) for row in table) for i in range(len(head))]
     for row in table:
         print("  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())

@@ -9,9 +9,9 @@ It differs only in which cells it visits: ``segment_is_clear`` scans the
 segment's whole bounding box, which is fine for a robot's short moves but
 costs ``O(length^2)`` cells on the long sight lines of Theta*;
 :func:`line_of_sight` scans a strip along the segment, column by column (or
-row by row for a steep segment), ``O(length)`` cells.  The strip is padded
-by one cell, so it always covers every square within ``clear`` of the
-segment; the per-cell test decides.
+row by row for a steep segment), ``O(length)`` cells.  The strip reaches
+``1e-7`` cell beyond ``clear``, so the rounding of its bounds never leaves out
+a square within ``clear`` of the segment; the per-cell test decides.
 
 :func:`smooth_path` is the post-smoothing of A* PS (Nash et al. 2007): from
 each kept point, skip ahead while the next point after is in sight.
@@ -66,7 +66,7 @@ def line_of_sight(ax, ay, bx, by, occ, ox, oy, res, clear):
         return False
     dx = bx - ax
     dy = by - ay
-    pad = clear + res  # one cell more than needed: rounding never leaves a square out
+    pad = clear + 1e-7 * res  # a sliver more than needed: rounding never leaves a square out
     if abs(dx) >= abs(dy):
         # column by column: the segment's y over the column's x-range (grown by clear)
         lo_x = min(ax, bx)

@@ -39,7 +39,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.field.forces import att_force_xy
-from pathfuse.field.motion import HOW_BLOCKED, safe_step, straight_move
+from pathfuse.field.motion import HOW_BLOCKED, safe_step, safe_step_margin, straight_move
 from pathfuse.field.pathing import advance_progress, find_rejoin
 from pathfuse.field.repulsion import (
     disc_repulsion,
@@ -76,7 +76,9 @@ F_OY, F_RES, F_RADIUS, F_KMOV, F_RHOMOV, F_REACH, F_AMAX, F_SWERVE, F_RVX, F_RVY
 F_SUBTOL, F_NEXP, F_SCALE = 20, 21, 22
 # fusion_loop only
 F_R1, F_R2, F_BACKOFF = 20, 21, 22
-N_F = 23
+# both: the soft safety margin (ours; 0 = off)
+F_MARGIN = 23
+N_F = 24
 # --- int settings
 I_STALLN, I_VELAWARE = 0, 1
 I_IMPROVED, I_TOGOAL = 2, 3  # field_loop
@@ -215,7 +217,8 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
         fx += rx
         fy += ry
         dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
-        nx, ny, how = safe_step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear)
+        nx, ny, how = safe_step_margin(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear,
+                                       f[F_MARGIN])
         if how == HOW_BLOCKED:
             code = CODE_BLOCKED
             break
@@ -236,7 +239,7 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
 
 def pack_field(goal, k_att, k_rep, rho0_m, step_m, tol_m, clear_m, stall_steps,
                stall_distance_m, ox, oy, res, subgoal_tol_m, improved, to_goal, rep_exponent,
-               rep_scale_m, discs):
+               rep_scale_m, discs, margin_m=0.0):
     """Float and int settings of :func:`field_loop`; ``discs`` is :func:`disc_settings`."""
     f = np.zeros(N_F)
     f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
@@ -244,6 +247,7 @@ def pack_field(goal, k_att, k_rep, rho0_m, step_m, tol_m, clear_m, stall_steps,
     f[F_STEP], f[F_TOL], f[F_CLEAR], f[F_STALLD] = step_m, tol_m, clear_m, stall_distance_m
     f[F_OX], f[F_OY], f[F_RES] = ox, oy, res
     f[F_SUBTOL], f[F_NEXP], f[F_SCALE] = subgoal_tol_m, rep_exponent, rep_scale_m
+    f[F_MARGIN] = margin_m
     i = np.zeros(N_I, dtype=np.int64)
     i[I_STALLN] = stall_steps
     i[I_IMPROVED] = 1 if improved else 0
@@ -287,8 +291,11 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
             return nx, ny, True, landed
         return x, y, False, False
     pull = f[F_KATT] * f[F_R1] / d
-    nx, ny, how = safe_step(x, y, pull * (tx - x) + dfx, pull * (ty - y) + dfy, step, occ, ox,
-                            oy, res, clear)
+    fx = pull * (tx - x) + dfx
+    fy = pull * (ty - y) + dfy
+    nx, ny, how = safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, f[F_MARGIN])
+    if how == HOW_BLOCKED and f[F_MARGIN] > 0.0:  # the margin gives way to the escape
+        nx, ny, how = safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
     if how == HOW_BLOCKED:
         return x, y, False, False
     return nx, ny, True, math.hypot(tx - nx, ty - ny) <= 0.5 * step
@@ -378,7 +385,8 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
             fx, fy, _ = fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0,
                                      r1, r2, occ, ox, oy, res)
             dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
-            nx, ny, how = safe_step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear)
+            nx, ny, how = safe_step_margin(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res,
+                                           clear, f[F_MARGIN])
             if how == HOW_BLOCKED:
                 blocked = True
             else:
@@ -475,7 +483,7 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
 
 def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, stall_steps,
                 stall_distance_m, ox, oy, res, ahead, escape, escape_points, backoff_window_m,
-                drive, discs):
+                drive, discs, margin_m=0.0):
     """Float and int settings of :func:`fusion_loop` (``r2_m`` is the repulsion radius)."""
     f = np.zeros(N_F)
     f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
@@ -483,6 +491,7 @@ def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, 
     f[F_STEP], f[F_TOL], f[F_CLEAR], f[F_STALLD] = step_m, tol_m, clear_m, stall_distance_m
     f[F_OX], f[F_OY], f[F_RES] = ox, oy, res
     f[F_R1], f[F_R2], f[F_BACKOFF] = r1_m, r2_m, backoff_window_m
+    f[F_MARGIN] = margin_m
     i = np.zeros(N_I, dtype=np.int64)
     i[I_STALLN] = stall_steps
     i[I_AHEAD] = ahead

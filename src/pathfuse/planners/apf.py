@@ -74,7 +74,7 @@ class SubgoalController(FieldController):
             problem.goal, p.k_att, p.k_rep, p.rho0_m, self.step_m, self.goal_tolerance_m,
             self.clear_m, p.stall_steps, self.stall_distance_m, ox, oy, g.resolution,
             self.subgoal_tolerance(), self.improved, self.rep_to_goal(), self.rep_exponent(),
-            self.rep_scale(), self.disc_settings())
+            self.rep_scale(), self.disc_settings(), problem.clearance_m)
         self.state = np.zeros(1, dtype=np.int64)
 
     def make_subgoals(self) -> np.ndarray:

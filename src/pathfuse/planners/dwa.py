@@ -111,7 +111,7 @@ class DWAParams(GlobalAStarParams):
                                     help="static gaps beyond this cost nothing")
     inflation_decay_m: float = param(0.1, gt=0, unit="m",
                                      help="the obstacle cost exp(-gap / decay)")
-    lookahead_m: float = param(1.5, gt=0, unit="m",
+    lookahead_m: float = param(0.5, gt=0, unit="m",
                                help="heading critic: aim at the path this far beyond the "
                                     "rollout end's projection")
     goal_tolerance_m: float = param(0.25, gt=0, unit="m",

@@ -249,8 +249,31 @@ def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     ``(c0, c1)`` is the last command: ``(v, omega)`` for a diff-drive robot,
     ``(vx, vy)`` for a holonomic one.  Returns ``(a0, a1, admissible_count,
     cost)`` with ``(a0, a1)`` in the same terms; with no admissible sample, the
-    slowest command of the window turning towards the local goal.
+    slowest command of the window turning towards the local goal.  With a
+    safety margin the samples are first held to keeping ``clear + min(margin,
+    max(present gap, margin / 2))`` (admissibility as above with that
+    clearance; a robot already deeper inside gets none passing); only when
+    none passes, to ``clear``.
     """
+    margin = f[D_MARGIN]
+    if margin > 0.0:
+        clear = f[D_CLEAR]
+        d = segment_static_distance(occ, f[D_OX], f[D_OY], f[D_RES], x, y, x, y,
+                                    clear + margin)
+        # keep the margin, or at least half of it where the robot still has that much
+        hi = clear + min(margin, max(d - clear, 0.5 * margin)) * (1.0 - 1e-9)
+        if hi > clear:
+            f2 = f.copy()
+            f2[D_CLEAR] = hi
+            a0, a1, count, best = _choose(occ, f2, x, y, th, c0, c1, pts, cum, k, dpos, dvel,
+                                          drad)
+            if count > 0:
+                return a0, a1, count, best
+    return _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad)
+
+
+@njit(cache=True)
+def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     dt = f[D_DT]
     vmax = f[D_VMAX]
     amax = f[D_AMAX]

@@ -319,17 +319,19 @@ def shapes_map(seed: int = 0, resolution: float = 0.1, size_m: Sequence[float] =
     """
     rng = np.random.default_rng([int(seed), 7919])
     w_m, h_m = (float(v) for v in size_m)
-    shapes = []
+    shapes: list[tuple[str, float, float, float, float]] = []
+    r_lo, r_hi = (float(v) for v in radius_range_m)
+    b_lo, b_hi = (float(v) for v in box_side_range_m)
     free = np.asarray(keep_free, dtype=np.float64).reshape(-1, 2)
     while len(shapes) < discs + boxes:
         kind = "disc" if len(shapes) < discs else "box"
         cx, cy = rng.uniform(0, w_m), rng.uniform(0, h_m)
         if kind == "disc":
-            r = rng.uniform(*radius_range_m)
+            r = rng.uniform(r_lo, r_hi)
             ext = r
             shape = ("disc", cx, cy, r, r)
         else:
-            hw, hh = rng.uniform(*box_side_range_m) / 2, rng.uniform(*box_side_range_m) / 2
+            hw, hh = rng.uniform(b_lo, b_hi) / 2, rng.uniform(b_lo, b_hi) / 2
             ext = math.hypot(hw, hh)
             shape = ("box", cx, cy, hw, hh)
         if free.size and np.min(np.hypot(free[:, 0] - cx, free[:, 1] - cy)) < \

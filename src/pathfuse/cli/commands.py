@@ -276,7 +276,7 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
     cfg = DynamicConfig(
         n_seeds=args.seeds, moving=tuple(args.moving), speed_range=parse_speed(args.speed),
         planners=parse_planner_list(args.planners), seed=args.seed,
-        params=parse_planner_params(args.param),
+        params=parse_planner_params(args.param), robot=_robot_block(args.robot),
     )
     for name in cfg.planners:
         _warm_with_notice(name)
@@ -300,6 +300,16 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
     return 0
 
+
+
+def _robot_block(items: Any) -> dict[str, Any]:
+    """``--robot KEY=VALUE`` items as a robot block (values read as YAML scalars)."""
+    from pathfuse.cli.args import parse_params
+
+    try:
+        return dict(parse_params(items))
+    except CliError as exc:
+        raise CliError(str(exc).replace("--param", "--robot")) from None
 
 
 def parse_seeds(text: str) -> int | str | list[int]:

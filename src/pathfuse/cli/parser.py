@@ -185,6 +185,7 @@ examples:
   pathfuse dynamic --seeds 50 --moving 0 2 4 8 --out dynamic-out
   pathfuse dynamic --seeds 100 --moving 0 4 8 12 --speed 0.5,1.0 --planners fusion,astar-replan
   pathfuse dynamic --seeds 200 --workers 2 --param fusion.repulsion=velocity --out velocity
+  pathfuse dynamic --seeds 200 --robot model=diff-drive --out dynamic-diff-drive
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -200,6 +201,10 @@ examples:
                     help="planner parameter, repeatable (e.g. --param fusion.swerve=0)")
     dy.add_argument("--seed", type=_nonneg_int, default=0,
                     help="master seed of the scenario family (default 0)")
+    dy.add_argument("--robot", action="append", metavar="KEY=VALUE",
+                    help="a key of the scenarios' robot: block, repeatable (e.g. --robot "
+                    "model=diff-drive --robot clearance=0.1; default: holonomic, radius 0.2 m, "
+                    "1 m/s)")
     dy.add_argument("--workers", type=_positive_int, default=None,
                     help="worker processes (default: every usable CPU; 1 = in this process)")
     dy.add_argument("--out", default="dynamic-out",

@@ -225,7 +225,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                   "params": {**dict(sc.planner.params), **params}}
     else:
         choice = {"name": args.planner, "params": params}
-    ep = simulate(sc, planner=choice, seed=args.seed)
+    robot = None
+    if args.robot:
+        from dataclasses import asdict
+
+        robot = {**asdict(sc.robot), **_robot_block(args.robot)}
+    ep = simulate(sc, planner=choice, seed=args.seed, robot=robot)
     anim = None
     if out is not None:
         anim = animate_episode(ep, out, format=fmt, fps=args.fps, frame_step=args.frame_step)

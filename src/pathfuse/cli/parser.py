@@ -140,6 +140,7 @@ examples:
 examples:
   pathfuse simulate examples/scenarios/head_on.yaml
   pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
+  pathfuse simulate examples/scenarios/corridor_crowd.yaml --planner dwa --robot model=diff-drive
   pathfuse simulate examples/scenarios/crossing.yaml --planner fusion --param repulsion=velocity
   pathfuse simulate examples/scenarios/random_walkers.yaml --seed 4 --json
   pathfuse simulate examples/scenarios/crossing.yaml --mp4 crossing.mp4 --fps 20 --frame-step 1
@@ -157,6 +158,9 @@ an animation plays in real time unless that takes more than 150 frames, then fas
                     help="planner parameter, repeatable (e.g. --param repulsion=velocity)")
     sm.add_argument("--seed", type=_nonneg_int, default=None,
                     help="episode seed for random walks (default: the scenario's)")
+    sm.add_argument("--robot", action="append", metavar="KEY=VALUE",
+                    help="override a key of the scenario's robot: block, repeatable (e.g. "
+                    "--robot model=diff-drive --robot clearance=0.1)")
     anim = sm.add_mutually_exclusive_group()
     anim.add_argument("--gif", metavar="OUT.gif", help="write an animated GIF")
     anim.add_argument("--mp4", metavar="OUT.mp4", help="write an MP4 video (needs ffmpeg)")

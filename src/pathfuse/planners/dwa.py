@@ -97,7 +97,7 @@ class DWAParams(GlobalAStarParams):
     v_samples: int = param(7, ge=2, help="linear speeds sampled in the window (holonomic: "
                                          "speeds from 0 to the limit)")
     w_samples: int = param(15, ge=3, help="yaw rates sampled in the window (holonomic: "
-                                          "directions)")
+                                          "3 x this many directions)")
     horizon_s: float = param(2.5, gt=0, unit="s", help="how long each sample is rolled out")
     sim_step_s: float = param(0.1, gt=0, unit="s", help="length of a rollout piece")
     dt_s: float = param(0.1, gt=0, unit="s",

@@ -13,6 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
+from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.sweep import (
     arc_deviation_bound,
     disc_sweep_gaps,
@@ -103,6 +104,8 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
     dt = f[D_DT]
     clear = f[D_CLEAR]
     radius = f[D_RADIUS]
+    # the edge rule of segment_is_clear: pathfuse's margin is kept from squares, not the edge
+    slack = MARGIN_FRAC * res
     horizon = f[D_HORIZON]
     h = f[D_SIMDT]
     rng = f[D_RANGE]
@@ -137,7 +140,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
     for i in range(1, n + 1):
         t = min(i * h, horizon)
         bx, by, bth = unicycle_pose(x, y, th, v, w, t)
-        d = segment_static_distance(occ, ox, oy, res, ax, ay, bx, by, cap) - e
+        d = segment_static_distance(occ, ox, oy, res, ax, ay, bx, by, cap, slack) - e
         if t <= dt + 1e-12:
             # the tick itself: the arc (lower bound) and the chord (the path offline) clear
             if d < clear:
@@ -145,7 +148,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
                 ok = False
                 break
             if e > 0.0 and segment_static_distance(occ, ox, oy, res, ax, ay, bx, by,
-                                                   clear) < clear:
+                                                   clear, slack) < clear:
                 first_ok = False
                 ok = False
                 break
@@ -260,7 +263,7 @@ def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     if margin > 0.0:
         clear = f[D_CLEAR]
         d = segment_static_distance(occ, f[D_OX], f[D_OY], f[D_RES], x, y, x, y,
-                                    clear + margin)
+                                    clear + margin, MARGIN_FRAC * f[D_RES])
         # keep the margin, or at least half of it where the robot still has that much
         hi = clear + min(margin, max(d - clear, 0.5 * margin)) * (1.0 - 1e-9)
         if hi > clear:

@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numba import njit
 
-from pathfuse.geometry import _segment_hits_box, segment_box_distance
+from pathfuse.geometry import MARGIN_FRAC, _segment_hits_box, segment_box_distance
 
 __all__ = ["line_of_sight", "smooth_path"]
 
@@ -51,16 +51,18 @@ def _cell_blocks(ax, ay, bx, by, x0, y0, res, clear):
 
 @njit(cache=True)
 def line_of_sight(ax, ay, bx, by, occ, ox, oy, res, clear):
-    """True when segment ``AB`` stays ``>= clear`` from every occupied square and the map edge.
+    """True when segment ``AB`` stays ``>= clear`` from every occupied square and inside the map,
+    at least ``clear - MARGIN_FRAC * res`` (the robot's radius) from its edge.
 
     The same answer as :func:`pathfuse.geometry.segment_is_clear`, visiting a
     strip of cells along the segment instead of its bounding box.
     """
     h, w = occ.shape
-    xmin = ox + clear
-    ymin = oy + clear
-    xmax = ox + w * res - clear
-    ymax = oy + h * res - clear
+    edge = max(clear - MARGIN_FRAC * res, 0.0)  # the edge rule of segment_is_clear:
+    xmin = ox + edge  # the robot's radius from the map's edge, the margin only from squares
+    ymin = oy + edge
+    xmax = ox + w * res - edge
+    ymax = oy + h * res - edge
     if not (xmin <= ax <= xmax and xmin <= bx <= xmax and ymin <= ay <= ymax
             and ymin <= by <= ymax):
         return False

@@ -267,10 +267,12 @@ def _corners_cached(occ: np.ndarray, q: float) -> tuple[np.ndarray, np.ndarray, 
     return hit
 
 
-def _outside_squares(x: float, y: float, occ: np.ndarray, q: float) -> bool:
-    """Whether the point (cell units) lies in the inset map and in no grown square's interior."""
+def _outside_squares(x: float, y: float, occ: np.ndarray, q: float, qe: float) -> bool:
+    """Whether the point (cell units) lies in the map inset by ``qe`` (the robot's radius: the
+    edge rule of :func:`pathfuse.geometry.segment_is_clear`, which keeps pathfuse's margin
+    from the squares only) and in no grown square's interior."""
     h, w = occ.shape
-    if not (q <= x <= w - q and q <= y <= h - q):
+    if not (qe <= x <= w - qe and qe <= y <= h - qe):
         return False
     c0, c1 = max(int(math.floor(x - q)) - 1, 0), min(int(math.floor(x + q)) + 1, w - 1)
     r0, r1 = max(int(math.floor(y - q)) - 1, 0), min(int(math.floor(y + q)) + 1, h - 1)
@@ -289,7 +291,7 @@ def shortest_path(occ: np.ndarray, ox: float, oy: float, res: float, robot_radiu
     """The shortest path from ``start`` to ``goal`` (world metres; see the module docstring).
 
     ``NO_PATH`` also when the start or the goal lies within the growth
-    ``rho`` (L-infinity) of a square or the map's edge.  ``max_expansions``
+    ``rho`` (L-infinity) of a square, or within the robot's radius of the map's edge.  ``max_expansions``
     caps the vertices expanded (``MAX_ITERATIONS``).
 
     ``upper_bound_m``, the length of any path (an A* path, say), speeds the
@@ -301,10 +303,11 @@ def shortest_path(occ: np.ndarray, ox: float, oy: float, res: float, robot_radiu
     t0 = time.perf_counter()
     occ = np.ascontiguousarray(occ, dtype=np.bool_)
     q = growth_cells(robot_radius_m, res)
+    qe = robot_radius_m / res
     sx, sy = (start[0] - ox) / res, (start[1] - oy) / res
     gx, gy = (goal[0] - ox) / res, (goal[1] - oy) / res
     for x, y in ((sx, sy), (gx, gy)):
-        if not _outside_squares(x, y, occ, q):
+        if not _outside_squares(x, y, occ, q, qe):
             return AnyAngleResult(Status.NO_PATH, np.zeros((0, 2)), math.inf, 0)
     cx, cy, ct = _corners_cached(occ, q)
     used = 0

@@ -291,8 +291,8 @@ def shortest_path(occ: np.ndarray, ox: float, oy: float, res: float, robot_radiu
     """The shortest path from ``start`` to ``goal`` (world metres; see the module docstring).
 
     ``NO_PATH`` also when the start or the goal lies within the growth
-    ``rho`` (L-infinity) of a square, or within the robot's radius of the map's edge.  ``max_expansions``
-    caps the vertices expanded (``MAX_ITERATIONS``).
+    ``rho`` (L-infinity) of a square, or within the robot's radius of the map's
+    edge.  ``max_expansions`` caps the vertices expanded (``MAX_ITERATIONS``).
 
     ``upper_bound_m``, the length of any path (an A* path, say), speeds the
     search up without changing its answer: only corners ``v`` with ``|s v| +

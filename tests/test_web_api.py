@@ -372,6 +372,23 @@ def _sleepy(seconds):
     pathfuse.register_function("nap", nap, P, "sleeps")
 
 
+def test_a_planner_that_raises_is_a_500_with_its_message(client):
+    from pathfuse.planners.params import Checked
+
+    @dataclasses.dataclass(frozen=True)
+    class P(Checked):
+        pass
+
+    def broken(grid, start, goal, params, budget):
+        raise RuntimeError("plug-in bug")
+
+    pathfuse.register_function("broken", broken, P, "raises")
+    r = client.post("/api/plan", json={"map": "paper", "planner": "broken"})
+    assert r.status_code == 500
+    assert r.json()["error"] == "internal error: RuntimeError: plug-in bug"
+    assert client.post("/api/plan", json={"map": "paper"}).status_code == 200  # still serving
+
+
 def test_a_request_over_the_budget_is_503():
     _sleepy(1.5)
     with TestClient(create_app(limits=Limits(time_budget_s=0.1, grace_s=0.2))) as c:

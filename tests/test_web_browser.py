@@ -203,7 +203,8 @@ def test_plan_paint_drag_and_the_field(page):
 
     def pixel():
         frames(pg)
-        return pg.evaluate("""([x, y]) => { const v = pathfuse.view, dpr = window.devicePixelRatio || 1;
+        return pg.evaluate("""([x, y]) => {
+            const v = pathfuse.view, dpr = window.devicePixelRatio || 1;
             const [px, py] = v.toScreen(x, y);
             return [...document.getElementById('canvas').getContext('2d')
               .getImageData(Math.round(px * dpr), Math.round(py * dpr), 1, 1).data]; }""", free)

@@ -122,6 +122,7 @@ function edited() {
   const m = state.map;
   if (!m) return;
   if ($("auto-plan").checked && m.width * m.height <= AUTO_CELLS) schedulePlan();
+  else setStatus(`${m.width} × ${m.height} cells: press Plan to plan (re-planning on every edit is for maps up to 256 × 256)`);
   if ($("layer-heat").checked || $("layer-arrows").checked) scheduleField();
   view.redraw();
 }
@@ -358,6 +359,7 @@ view.drawers.push((ctx, v) => {
   v.disc(ctx, p[0], p[1], v.px(4), "#fff", "#9333ea", 2);
 });
 view.drawers.push((ctx, v) => {
+  if (player.ep) return;  // the episode draws the discs where they are
   for (const s of scene.starts()) {
     v.disc(ctx, s.p[0], s.p[1], s.r, "rgba(217,119,6,.35)", "#b45309", 1.5);
     if (s.v) v.arrow(ctx, s.p[0], s.p[1], s.v[0], s.v[1], "#b45309", 2);
@@ -419,8 +421,15 @@ canvas.addEventListener("pointerdown", (e) => {
   else drag = { kind: "pan", x: e.clientX, y: e.clientY };
 });
 canvas.addEventListener("pointermove", (e) => {
-  if (!drag) return;
   const w = eventWorld(e);
+  if (state.map) {
+    const [r, c] = view.cellAt(w[0], w[1]);
+    const m = state.map;
+    const inMap = r >= 0 && c >= 0 && r < m.height && c < m.width;
+    $("legend").textContent = `x ${w[0].toFixed(2)} m, y ${w[1].toFixed(2)} m` +
+      (inMap ? `, cell (${r}, ${c})${m.occ[r * m.width + c] ? " occupied" : ""}` : "");
+  }
+  if (!drag) return;
   if (drag.kind === "pan") {
     view.panBy(e.clientX - drag.x, e.clientY - drag.y);
     drag.x = e.clientX; drag.y = e.clientY;
@@ -543,7 +552,11 @@ async function init() {
     getJSON("/api/planners"), getJSON("/api/maps"), getJSON("/api/scenarios")]);
   const box = $("planners");
   planners.forEach((p, i) => {
-    const f = plannerForm(p, PALETTE[i % PALETTE.length], () => { renderTable(); schedulePlan(); scheduleField(); });
+    const f = plannerForm(p, PALETTE[i % PALETTE.length], () => {
+      const m = state.map;
+      if (m && $("auto-plan").checked && m.width * m.height <= AUTO_CELLS) schedulePlan();
+      scheduleField();
+    });
     if (p.name === "astar" || p.name === "fusion") f.check.checked = true;
     state.forms.push(f);
     box.append(f.box);
@@ -571,6 +584,7 @@ async function init() {
   $("sim-run").addEventListener("click", runEpisode);
   $("sim-export").addEventListener("click", exportScene);
   $("discs-clear").addEventListener("click", () => { scene.clear(); player.unload(); });
+  scene.onChange = () => { scene.renderList($("discs")); player.unload(); };
   $("scenario-load").addEventListener("click", loadScenario);
   $("scenario-file").addEventListener("change", uploadScenario);
   await loadSelectedMap();

@@ -21,7 +21,8 @@ measured in Debian's chromium (Playwright) with ``requestAnimationFrame`` timest
 
 Usage::
 
-    python benchmarks/bench_web.py [--data DIR] [--repeat 30] [--cli 5] [--no-browser]
+    python benchmarks/bench_web.py [--data DIR] [--repeat 200] [--repeat-big 10] [--cli 5]
+        [--no-browser]
 """
 
 from __future__ import annotations
@@ -82,20 +83,23 @@ def timed_requests(pid: int, fn, repeat: int) -> tuple[float, float, dict]:
     return statistics.median(walls), (cpu_s(pid) - c0) / repeat, out
 
 
-def median_time(fn, repeat: int) -> float:
+def median_time(fn, repeat: int) -> tuple[float, float]:
+    """Median wall time and mean CPU time (this process) of ``fn()``, after one warm-up."""
     fn()
     out = []
+    c0 = time.process_time()
     for _ in range(repeat):
         t0 = time.perf_counter()
         fn()
         out.append(time.perf_counter() - t0)
-    return statistics.median(out)
+    return statistics.median(out), (time.process_time() - c0) / repeat
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
-    ap.add_argument("--repeat", type=int, default=30)
+    ap.add_argument("--repeat", type=int, default=200, help="requests per paper-map case")
+    ap.add_argument("--repeat-big", type=int, default=10, help="requests per 1024-map case")
     ap.add_argument("--cli", type=int, default=5, help="command-line runs per query")
     ap.add_argument("--no-browser", action="store_true")
     args = ap.parse_args()
@@ -148,38 +152,43 @@ def main() -> None:
                  (big_name, "fusion", {"map": big_map}, grid, start, goal, big_cli)]
         for name, planner, mref, g, s0, g0, cli in cases:
             body = {**mref, "start": s0, "goal": g0, "planner": planner}
+            n = args.repeat if g.occupied.size < 100_000 else args.repeat_big
             wall, cpu, out = timed_requests(proc.pid, lambda b=body: post(base + "/api/plan", b),
-                                            args.repeat)
+                                            n)
             lib = median_time(lambda g=g, s0=s0, g0=g0, p=planner:
-                              pathfuse.plan(g, s0, g0, planner=p), args.repeat)
+                              pathfuse.plan(g, s0, g0, planner=p), n)
             cli_s = None
             if cli is not None and args.cli:
                 argv = [sys.executable, "-m", "pathfuse.cli", "plan", *cli, "--start",
                         f"{s0[0]},{s0[1]}", "--goal", f"{g0[0]},{g0[1]}", "--planner",
                         planner, "--json"]
                 cli_s = median_time(lambda a=argv: subprocess.run(a, capture_output=True,
-                                                                  check=True), args.cli)
-            rows.append(("/api/plan", name, planner, out["status"], wall, cpu, lib, cli_s))
+                                                                  check=True), args.cli)[0]
+            rows.append(("/api/plan", name, planner, out["status"], n, wall, cpu, lib, cli_s))
         fbody = {"map": big_map, "goal": goal, "planner": "fusion"}
         wall, cpu, out = timed_requests(proc.pid, lambda: post(base + "/api/field", fbody),
-                                        args.repeat)
-        lib = median_time(lambda: potential_field(grid, tuple(goal), 40.0, 5.0, 2.0), args.repeat)
-        rows.append(("/api/field", big_name, "fusion gains", f"{out['heat']['shape']}", wall,
-                     cpu, lib, None))
+                                        args.repeat_big * 3)
+        lib = median_time(lambda: potential_field(grid, tuple(goal), 40.0, 5.0, 2.0),
+                          args.repeat_big * 3)
+        rows.append(("/api/field", big_name, "fusion gains", f"{out['heat']['shape']}",
+                     args.repeat_big * 3, wall, cpu, lib, None))
     finally:
         proc.terminate()
         proc.wait(timeout=10)
 
-    print(f"\nmedian over {args.repeat} requests (wall = round trip on loopback; server CPU "
-          "per request from /proc; in-process = the library call without HTTP)\n")
-    print("| endpoint | map | planner | answer | round trip ms | server CPU ms | "
-          "in-process ms | HTTP / in-process | CLI process ms | CLI / HTTP |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
-    for ep, name, planner, status, wall, cpu, lib, cli_s in rows:
+    print("\nwall: median round trip on loopback (new connection per request, as urllib does);"
+          " server CPU: mean per request, from /proc (10 ms ticks, so a mean over n);\n"
+          "in-process: pathfuse.plan() / potential_field() in this process, median wall and "
+          "mean CPU; CLI: one `pathfuse plan --json` process per query, median wall\n")
+    print("| endpoint | map | planner | answer | n | round trip ms | server CPU ms | "
+          "in-process ms (CPU) | round trip / in-process | CLI process ms | CLI / round trip |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for ep, name, planner, status, n, wall, cpu, lib, cli_s in rows:
         cli_txt = "–" if cli_s is None else f"{1e3 * cli_s:.0f}"
         ratio = "–" if cli_s is None else f"{cli_s / wall:.0f}x"
-        print(f"| {ep} | {name} | {planner} | {status} | {1e3 * wall:.2f} | {1e3 * cpu:.2f} | "
-              f"{1e3 * lib:.3f} | {wall / lib:.1f}x | {cli_txt} | {ratio} |")
+        print(f"| {ep} | {name} | {planner} | {status} | {n} | {1e3 * wall:.2f} | "
+              f"{1e3 * cpu:.2f} | {1e3 * lib[0]:.3f} ({1e3 * lib[1]:.3f}) | {wall / lib[0]:.1f}x "
+              f"| {cli_txt} | {ratio} |")
     print(f"\nload average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} at the end")
     if not args.no_browser:
         playback()

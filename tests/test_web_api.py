@@ -17,17 +17,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("starlette")
-pytest.importorskip("httpx")
-
 with warnings.catch_warnings():  # starlette suggests httpx2, a fork; httpx works
     warnings.simplefilter("ignore")
-    from starlette.testclient import TestClient  # noqa: E402
+    from starlette.testclient import TestClient
 
-import pathfuse  # noqa: E402
-from pathfuse.cli import main  # noqa: E402
-from pathfuse.web.app import create_app  # noqa: E402
-from pathfuse.web.maps import Limits, grid_from_bits, grid_to_json  # noqa: E402
+import pathfuse
+from pathfuse.cli import main
+from pathfuse.web.app import create_app
+from pathfuse.web.maps import Limits, grid_from_bits, grid_to_json
 
 DATA = Path(__file__).parent / "data"
 ROOT = Path(__file__).resolve().parents[1]

@@ -24,8 +24,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
-
-sync_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed")
+from playwright import sync_api  # the test extra installs it (never `playwright install`)
 
 CHROMIUM = next((p for p in (os.environ.get("PATHFUSE_CHROMIUM"), "/usr/bin/chromium",
                              shutil.which("chromium"), shutil.which("chromium-browser")) if p

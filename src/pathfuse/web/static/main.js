@@ -19,7 +19,10 @@ const state = {
 const view = new View($("canvas"));
 const scene = new Scene(() => { scene.renderList($("discs")); view.redraw(); });
 const player = new Player(view, { play: $("play"), time: $("time"), speed: $("play-speed") },
-  () => {});
+  (k) => {
+    const ep = player.ep;
+    $("time-label").textContent = ep ? `${(k * ep.dt).toFixed(1)} / ${(ep.n_ticks * ep.dt).toFixed(1)} s` : "";
+  });
 window.pathfuse = { state, view, scene, player };  // for the browser tests and the curious
 
 function setStatus(text) { $("status").textContent = text; }

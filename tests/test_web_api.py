@@ -23,6 +23,7 @@ with warnings.catch_warnings():  # starlette suggests httpx2, a fork; httpx work
 
 import pathfuse
 from pathfuse.cli import main
+from pathfuse.validate import param_spec
 from pathfuse.web.app import create_app
 from pathfuse.web.maps import Limits, grid_from_bits, grid_to_json
 
@@ -96,10 +97,12 @@ def test_planners_loop_over_the_registry(client):
         fields = dataclasses.fields(spec.params_cls)
         assert [q["name"] for q in p["params"]] == [f.name for f in fields]
         defaults = spec.params_cls()
-        for q in p["params"]:
+        for q, f in zip(p["params"], fields, strict=True):
             assert q["default"] == getattr(defaults, q["name"])
             assert q["kind"] in ("float", "int", "bool", "choice", "str")
-            assert q["help"]
+            ps = param_spec(f)
+            if ps is not None:  # declared with param(): its metadata (test plug-ins may not)
+                assert q["help"] == ps.help and q["unit"] == ps.unit and q["kind"] == ps.kind
         assert ("closed" in p["layers"]) == spec.uses_astar
     fusion = next(p for p in got if p["name"] == "fusion")
     r1 = next(q for q in fusion["params"] if q["name"] == "r1_m")

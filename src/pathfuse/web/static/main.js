@@ -338,7 +338,7 @@ function drawArrows(ctx, v) {
 view.drawers.push(drawArrows);
 view.drawers.push((ctx, v) => {
   for (const [name, r] of state.results) {
-    if (r.error) continue;
+    if (r.error || (state.only && state.only !== name)) continue;  // only: one path alone
     const c = colorOf(name);
     if (r.extras && r.extras.astar_path && r.planner !== "astar") {
       v.polyline(ctx, r.extras.astar_path, c + "66", 1, [3, 3]);

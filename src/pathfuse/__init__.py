@@ -50,6 +50,7 @@ _EXPORTS: dict[str, str] = {
     "Episode": "pathfuse.world.episode",
     "World": "pathfuse.world.world",
     "load_scenario": "pathfuse.world.scenario",
+    "RobotModel": "pathfuse.robot",
 }
 
 __all__ = [
@@ -84,6 +85,7 @@ __all__ = [
     "Episode",
     "World",
     "load_scenario",
+    "RobotModel",
     "__version__",
 ]
 
@@ -135,6 +137,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and IDEs
         QueryError,
         Status,
     )
+    from pathfuse.robot import RobotModel
     from pathfuse.world.episode import Episode, simulate
     from pathfuse.world.scenario import load_scenario
     from pathfuse.world.world import World

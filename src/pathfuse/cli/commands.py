@@ -225,7 +225,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                   "params": {**dict(sc.planner.params), **params}}
     else:
         choice = {"name": args.planner, "params": params}
-    ep = simulate(sc, planner=choice, seed=args.seed)
+    robot = None
+    if args.robot:
+        from dataclasses import asdict
+
+        robot = {**asdict(sc.robot), **_robot_block(args.robot)}
+    ep = simulate(sc, planner=choice, seed=args.seed, robot=robot)
     anim = None
     if out is not None:
         anim = animate_episode(ep, out, format=fmt, fps=args.fps, frame_step=args.frame_step)
@@ -276,7 +281,7 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
     cfg = DynamicConfig(
         n_seeds=args.seeds, moving=tuple(args.moving), speed_range=parse_speed(args.speed),
         planners=parse_planner_list(args.planners), seed=args.seed,
-        params=parse_planner_params(args.param),
+        params=parse_planner_params(args.param), robot=_robot_block(args.robot),
     )
     for name in cfg.planners:
         _warm_with_notice(name)
@@ -300,6 +305,16 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
     return 0
 
+
+
+def _robot_block(items: Any) -> dict[str, Any]:
+    """``--robot KEY=VALUE`` items as a robot block (values read as YAML scalars)."""
+    from pathfuse.cli.args import parse_params
+
+    try:
+        return dict(parse_params(items))
+    except CliError as exc:
+        raise CliError(str(exc).replace("--param", "--robot")) from None
 
 
 def parse_seeds(text: str) -> int | str | list[int]:

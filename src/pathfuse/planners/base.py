@@ -340,6 +340,14 @@ class FieldController(Controller):
 
         best = gap(x, y)
         best_xy = None
+        clear = self.clear_m
+        margin = self.problem.clearance_m
+        if margin > 0:  # keep the safety margin, or what is left of it (ours)
+            from pathfuse.sweep import segment_static_distance
+
+            d = segment_static_distance(g.occupied, float(ox), float(oy), g.resolution, x, y,
+                                        x, y, clear + margin)
+            clear = max(clear, clear + min(margin, max(d - clear, 0.0)) * (1.0 - 1e-9))
         if fx == 0.0 and fy == 0.0:
             gx, gy = self.problem.goal
             fx, fy = gx - x, gy - y
@@ -347,7 +355,7 @@ class FieldController(Controller):
         for k in range(12):
             a = a0 + math.pi / 6 * ((k + 1) // 2) * (1 if k % 2 else -1)
             tx, ty = x + step * math.cos(a), y + step * math.sin(a)
-            if segment_is_clear(x, y, tx, ty, g.occupied, ox, oy, g.resolution, self.clear_m):
+            if segment_is_clear(x, y, tx, ty, g.occupied, ox, oy, g.resolution, clear):
                 gp = gap(tx, ty)
                 if gp > best + 1e-9:
                     best, best_xy = gp, (tx, ty)

@@ -52,6 +52,7 @@ def test_metric_clips_between_2_and_8_optimal_times(time_s, metric):
 def test_world_selection_and_folder_errors(tmp_path):
     assert parse_world_selection("20, 0-1,17") == ((0, 1), (17, 17), (20, 20))
     assert parse_world_selection(None) is None
+    assert parse_world_selection(((0, 1), (17, 17))) == ((0, 1), (17, 17))  # idempotent
     for bad in ("", "a", "3-1", "1,,x"):
         with pytest.raises(ConfigError, match="worlds"):
             parse_world_selection(bad)
@@ -232,6 +233,9 @@ def test_barn_experiment_file(tmp_path):
              "--out", tmp_path / "o")
     assert p.returncode == 0, p.stderr
     assert "astar" in p.stdout and "1/1 = 100.0%" in p.stdout and "fusion " not in p.stdout
+    p = _cli("barn", f, "--workers", 1, "--out", tmp_path / "o2")  # the file's own worlds
+    assert p.returncode == 0, p.stderr
+    assert "2 episodes (1 planner x 2 worlds)" in p.stdout
 
 
 def test_shipped_experiment_file_reads():

@@ -378,7 +378,7 @@ def load_barn_file(path: str | os.PathLike[str]) -> tuple[BarnConfig, dict[str, 
     if "directory" not in doc or not isinstance(doc["directory"], str):
         raise ConfigError(f"{p}: directory: missing (the BARN folder, relative to the file)")
     d = Path(os.path.expanduser(doc["directory"]))
-    kw: dict[str, Any] = {"directory": str(d if d.is_absolute() else p.parent / d)}
+    kw: dict[str, Any] = {"directory": os.path.normpath(d if d.is_absolute() else p.parent / d)}
     for key in ("worlds", "resolution", "dt", "robot", "params"):
         if doc.get(key) is not None:
             kw[key] = doc[key]

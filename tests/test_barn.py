@@ -104,17 +104,20 @@ def test_every_episode_rechecked_for_collision(barn_run):
     worlds = {w.index: w for w in barn_run.worlds}
     assert len(barn_run.records) == len(worlds) * len(cfg.planners)
     checked = 0
-    for rec in barn_run.records:
-        w = worlds[rec["world"]]
+    cylinders = {}
+    grids = {}
+    for i, w in worlds.items():
         shapes = world_footprints(w.world)
-        centres = np.array([fp.center for fp in shapes.footprints])
-        cyl_r = np.array([fp.radius for fp in shapes.footprints])
+        cylinders[i] = (np.array([fp.center for fp in shapes.footprints]),
+                        np.array([fp.radius for fp in shapes.footprints]))
+        grids[i] = read_gazebo_world(w.world, cfg.resolution, bounds=BARN_BOUNDS)
+    for rec in barn_run.records:
+        centres, cyl_r = cylinders[rec["world"]]
         traj = np.array(rec["trajectory"])
         assert traj.shape[1] == 4 and traj[0].tolist()[:3] == [0.0, *BARN_START]
         assert np.allclose(np.diff(traj[:, 0]), cfg.dt)
         pos = traj[:, 1:3]
-        grid = read_gazebo_world(w.world, cfg.resolution, bounds=BARN_BOUNDS)
-        m = evaluate(grid, PlanResult(Status.SUCCESS, pos), radius)
+        m = evaluate(grids[rec["world"]], PlanResult(Status.SUCCESS, pos), radius)
         if rec["status"] == "collision":
             assert not m["collision_free"]  # the simulator's collision is real on the grid
             continue

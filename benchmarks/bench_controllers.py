@@ -84,10 +84,10 @@ def main() -> None:
                   f"{cpu / wall:9.2f}", flush=True)
     print(f"load average {os.getloadavg()[0]:.2f} at the end")
     if "dwa" in names:
-        print("\ndecision time relative to dwa (same robot):")
+        print("\nhow many times a dwa decision costs another controller's (same robot):")
         for model in ("holonomic", "diff-drive"):
             ref = rows[("dwa", model)]
-            print(f"  {model}: " + ", ".join(f"{n} {rows[(n, model)] / ref:.2f}x"
+            print(f"  {model}: " + ", ".join(f"{n} {ref / rows[(n, model)]:.0f}x"
                                             for n in names if n != "dwa"))
 
 

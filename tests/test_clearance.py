@@ -97,7 +97,7 @@ SCENARIOS = sorted(glob.glob("examples/scenarios/*.yaml"))
 
 
 @pytest.mark.parametrize("path", SCENARIOS)
-@pytest.mark.parametrize("name", ["astar-replan", "apf", "ref6", "ref7", "dwa"])
+@pytest.mark.parametrize("name", ["astar-replan", "apf", "fusion", "ref6", "ref7", "dwa"])
 def test_no_example_skims_a_wall_with_a_margin(path, name):
     sc = load_scenario(path)
     robot = {"radius": sc.robot.radius, "sensing_radius": sc.robot.sensing_radius,

@@ -458,8 +458,12 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
             ri = -1
             rj = -1
             if escape == 1:
-                ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox, oy,
-                                     res, clear, kbuf, drive)
+                if f[F_MARGIN] > 0.0:  # a way back that keeps the safety margin first
+                    ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox,
+                                         oy, res, clear + f[F_MARGIN], kbuf, drive)
+                if ri < 0:
+                    ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox,
+                                         oy, res, clear, kbuf, drive)
             if ri < 0:
                 code = CODE_BLOCKED if blocked else CODE_STALLED
                 break

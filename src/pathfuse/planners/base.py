@@ -32,6 +32,7 @@ from pathfuse.field.kernels import (
     CODE_GOAL_SNAP,
     CODE_RUNNING,
     CODE_STALLED,
+    F_CLEAR,
     F_RVX,
     F_RVY,
     code_status,
@@ -301,7 +302,10 @@ class FieldController(Controller):
             discs = _NO_DISCS
         self.f[F_RVX] = float(obs.velocity[0])
         self.f[F_RVY] = float(obs.velocity[1])
+        tight = self._tight(x, y)
         code, _ = self._call(1, *discs)
+        if tight:
+            self.f[F_CLEAR] = self.clear_m
         if code in (CODE_STALLED, CODE_BLOCKED):
             self.on_stuck()
         if self.n > n0:
@@ -315,6 +319,23 @@ class FieldController(Controller):
                 nx, ny = d
         dt = float(self.dt)  # type: ignore[arg-type]
         return np.array([(nx - x) / dt, (ny - y) / dt])
+
+    def _tight(self, x: float, y: float) -> bool:
+        """Online, a robot that the world left closer to a wall than the controller's
+        clearance (a diff-drive robot braking late) may keep what it has for this move;
+        True when the clearance was lowered for it."""
+        rb = self.problem.robot
+        if rb is None or not rb.is_diff_drive:
+            return False
+        from pathfuse.sweep import segment_static_distance
+
+        g = self.problem.grid
+        d = segment_static_distance(g.occupied, float(g.origin[0]), float(g.origin[1]),
+                                    float(g.resolution), x, y, x, y, self.clear_m)
+        if d >= self.clear_m:
+            return False
+        self.f[F_CLEAR] = d * (1.0 - 1e-12)
+        return True
 
     def on_stuck(self) -> None:
         """Online: the loop stalled or was blocked and could not escape; keep going."""

@@ -28,7 +28,8 @@ as it is.  A diff-drive robot gets ``(v, omega)`` from
    lowest speed with the desired yaw rate is taken (the world judges it).
    With a safety margin (``clearance_m``, ours) all this is first tried
    keeping ``radius + min(margin, present gap)`` clear, then with the
-   radius alone.
+   radius alone.  A robot already closer than that (it braked too late) may
+   keep its present clearance: moves that do not reduce it pass.
 
 So a robot that can brake in time never drives into a wall because of the
 conversion, turning on the spot is always allowed (the footprint is a
@@ -109,10 +110,13 @@ def unicycle_command(occ: np.ndarray, ox: float, oy: float, res: float, x: float
     vlo = max(vmin, v0 - amax * dt)
     vhi = min(vmax, v0 + amax * dt)
     v = min(max(v_des, vlo), vhi)
+    # a robot that came closer than ``clear`` (braking too late) may keep what it has
+    d = segment_static_distance(occ, ox, oy, res, x, y, x, y, clear + margin + 1.0)
+    if d < clear:
+        clear = d * (1.0 - 1e-12)
     # with a safety margin: first keep it (or what is left of it), then only the radius
     hi = clear
     if margin > 0.0:
-        d = segment_static_distance(occ, ox, oy, res, x, y, x, y, clear + margin)
         hi = max(clear, clear + min(margin, max(d - clear, 0.0)) * (1.0 - 1e-9))
     for pas in range(2 if hi > clear else 1):
         cl = hi if pas == 0 else clear

@@ -158,6 +158,10 @@ def test_barn_reference_path_lies_clear_of_the_cylinders():
     xy = np.stack([0.15 * p[:, 0] - 4.575, 0.15 * p[:, 1] + 5.075], axis=1)
     gap = np.hypot(xy[:, None, 0] - c[None, :, 0], xy[:, None, 1] - c[None, :, 1]).min(1)
     assert gap.min() - 0.075 > 0.2
+    # the swapped reading (i as y, j as x) runs through cylinders: the transform is pinned
+    yx = np.stack([0.15 * p[:, 1] - 4.575, 0.15 * p[:, 0] + 5.075], axis=1)
+    gap = np.hypot(yx[:, None, 0] - c[None, :, 0], yx[:, None, 1] - c[None, :, 1]).min(1)
+    assert gap.min() - 0.075 < 0
 
 
 # --------------------------------------------------------------------- bad input

@@ -52,6 +52,7 @@ def test_metric_clips_between_2_and_8_optimal_times(time_s, metric):
 def test_world_selection_and_folder_errors(tmp_path):
     assert parse_world_selection("20, 0-1,17") == ((0, 1), (17, 17), (20, 20))
     assert parse_world_selection(None) is None
+    assert parse_world_selection(((0, 1), (17, 17))) == ((0, 1), (17, 17))  # idempotent
     for bad in ("", "a", "3-1", "1,,x"):
         with pytest.raises(ConfigError, match="worlds"):
             parse_world_selection(bad)
@@ -103,17 +104,20 @@ def test_every_episode_rechecked_for_collision(barn_run):
     worlds = {w.index: w for w in barn_run.worlds}
     assert len(barn_run.records) == len(worlds) * len(cfg.planners)
     checked = 0
-    for rec in barn_run.records:
-        w = worlds[rec["world"]]
+    cylinders = {}
+    grids = {}
+    for i, w in worlds.items():
         shapes = world_footprints(w.world)
-        centres = np.array([fp.center for fp in shapes.footprints])
-        cyl_r = np.array([fp.radius for fp in shapes.footprints])
+        cylinders[i] = (np.array([fp.center for fp in shapes.footprints]),
+                        np.array([fp.radius for fp in shapes.footprints]))
+        grids[i] = read_gazebo_world(w.world, cfg.resolution, bounds=BARN_BOUNDS)
+    for rec in barn_run.records:
+        centres, cyl_r = cylinders[rec["world"]]
         traj = np.array(rec["trajectory"])
         assert traj.shape[1] == 4 and traj[0].tolist()[:3] == [0.0, *BARN_START]
         assert np.allclose(np.diff(traj[:, 0]), cfg.dt)
         pos = traj[:, 1:3]
-        grid = read_gazebo_world(w.world, cfg.resolution, bounds=BARN_BOUNDS)
-        m = evaluate(grid, PlanResult(Status.SUCCESS, pos), radius)
+        m = evaluate(grids[rec["world"]], PlanResult(Status.SUCCESS, pos), radius)
         if rec["status"] == "collision":
             assert not m["collision_free"]  # the simulator's collision is real on the grid
             continue
@@ -245,6 +249,9 @@ def test_barn_experiment_file(tmp_path):
              "--out", tmp_path / "o")
     assert p.returncode == 0, p.stderr
     assert "astar" in p.stdout and "1/1 = 100.0%" in p.stdout and "fusion " not in p.stdout
+    p = _cli("barn", f, "--workers", 1, "--out", tmp_path / "o2")  # the file's own worlds
+    assert p.returncode == 0, p.stderr
+    assert "2 episodes (1 planner x 2 worlds)" in p.stdout
 
 
 def test_shipped_experiment_file_reads():

@@ -158,6 +158,10 @@ def test_barn_reference_path_lies_clear_of_the_cylinders():
     xy = np.stack([0.15 * p[:, 0] - 4.575, 0.15 * p[:, 1] + 5.075], axis=1)
     gap = np.hypot(xy[:, None, 0] - c[None, :, 0], xy[:, None, 1] - c[None, :, 1]).min(1)
     assert gap.min() - 0.075 > 0.2
+    # the swapped reading (i as y, j as x) runs through cylinders: the transform is pinned
+    yx = np.stack([0.15 * p[:, 1] - 4.575, 0.15 * p[:, 0] + 5.075], axis=1)
+    gap = np.hypot(yx[:, None, 0] - c[None, :, 0], yx[:, None, 1] - c[None, :, 1]).min(1)
+    assert gap.min() - 0.075 < 0
 
 
 # --------------------------------------------------------------------- bad input
@@ -257,3 +261,26 @@ def test_argument_errors(tmp_path):
         pathfuse.load_map(KNOWN, origin=(0, 0))
     with pytest.raises(MapError, match="larger than"):
         read_gazebo_world(KNOWN, 1e-4)  # 1e10 cells: refused before allocating
+
+
+def test_gazebo_map_in_a_bench_experiment_and_a_scenario(tmp_path):
+    from pathfuse.bench import ResultStore, run_bench
+    from pathfuse.world import load_scenario
+
+    exp = tmp_path / "exp.yaml"
+    exp.write_text(
+        "name: g\nseeds: 1\nmaps:\n"
+        f"  - name: known\n    map: {{gazebo: {KNOWN}, resolution: 0.5, bounds: [0, 0, 8, 6]}}\n"
+        "    queries: [{start: [0.25, 3.25], goal: [7.75, 5.75]}]\n"
+        "planners: [astar]\n")
+    summary = run_bench(exp, tmp_path / "g.db", workers=1, progress=False)
+    assert summary.errors == 0
+    store = ResultStore(tmp_path / "g.db")
+    try:
+        (row,) = store.results()
+    finally:
+        store.close()
+    assert row["status_name"] == "SUCCESS" and row["collision_free"]
+    sc = load_scenario({"map": {"gazebo": str(KNOWN), "resolution": 1.0, "bounds": [0, 0, 8, 6]},
+                        "start": [3.5, 2.5], "goal": [6.5, 5.5], "robot": {"radius": 0.2}})
+    assert _rows(sc.grid) == KNOWN_ROWS

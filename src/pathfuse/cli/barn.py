@@ -121,9 +121,11 @@ def cmd_barn(args: argparse.Namespace) -> int:
         for path in files.values():
             print(f"wrote {path}", file=sys.stderr)
         return 0
-    print(f"{len(run.records)} episodes ({len(cfg.planners)} planners x {len(run.worlds)} "
-          f"worlds) in {run.wall_s:.1f} s ({run.workers} worker"
-          f"{'s' if run.workers != 1 else ''})\n")
+    def n(k: int, what: str) -> str:
+        return f"{k} {what}{'' if k == 1 else 's'}"
+
+    print(f"{n(len(run.records), 'episode')} ({n(len(cfg.planners), 'planner')} x "
+          f"{n(len(run.worlds), 'world')}) in {run.wall_s:.1f} s ({n(run.workers, 'worker')})\n")
     print(text_table(summary_rows(run.records, cfg.planners)))
     print("\nDWA (published): the challenge's baseline in Gazebo (move_base, 50 worlds x 10 "
           "runs), a reference line, not a like-for-like comparison.\n")

@@ -64,7 +64,6 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -463,8 +462,3 @@ def read_gazebo_world(
             "skipped": shapes.skipped, "models": shapes.models,
             "state_poses": shapes.state_poses}
     return GridMap(occ, res, origin, name or stem, meta)
-
-
-def iter_footprints(grid: GridMap) -> Iterator[Footprint]:
-    """The exact footprints behind a map read by :func:`read_gazebo_world` (none otherwise)."""
-    yield from grid.meta.get("footprints", ())

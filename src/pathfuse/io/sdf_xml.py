@@ -42,6 +42,7 @@ class SdfDoc:
         self.lines: dict[int, int] = {}
         builder = ET.TreeBuilder()
         parser = xml.parsers.expat.ParserCreate()
+        parser.buffer_text = True  # one data call per text run, not per chunk
 
         def start(tag: str, attrs: dict[str, str]) -> None:
             el = builder.start(tag, attrs)

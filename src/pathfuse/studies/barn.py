@@ -135,6 +135,13 @@ def parse_world_selection(text: str | Sequence[int] | None
     if text is None:
         return None
     out: list[tuple[int, int]] = []
+    if isinstance(text, tuple) and text and all(
+            isinstance(r, tuple) and len(r) == 2 for r in text):  # already parsed
+        for a, b in text:
+            if not all(isinstance(v, int) and not isinstance(v, bool) for v in (a, b)) \
+                    or not 0 <= a <= b:
+                raise ConfigError(f"worlds: expected ranges (first, last), got {text!r}")
+        return tuple(sorted(set(text)))
     if not isinstance(text, str):
         vals = list(text)
         if not vals or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool)
@@ -212,9 +219,7 @@ def find_worlds(directory: str | os.PathLike[str],
             found.setdefault(int(m.group(1)), f)
     if not found:
         raise ConfigError(f"{wdir}: no BARN world (world_N.world or world_N.world.gz) in it")
-    ranges = parse_world_selection(selection) if not (
-        isinstance(selection, tuple) and all(isinstance(r, tuple) for r in selection)) \
-        else selection
+    ranges = parse_world_selection(selection)
     if ranges is None:
         chosen = sorted(found)
     else:
@@ -373,7 +378,7 @@ def load_barn_file(path: str | os.PathLike[str]) -> tuple[BarnConfig, dict[str, 
     if "directory" not in doc or not isinstance(doc["directory"], str):
         raise ConfigError(f"{p}: directory: missing (the BARN folder, relative to the file)")
     d = Path(os.path.expanduser(doc["directory"]))
-    kw: dict[str, Any] = {"directory": str(d if d.is_absolute() else p.parent / d)}
+    kw: dict[str, Any] = {"directory": os.path.normpath(d if d.is_absolute() else p.parent / d)}
     for key in ("worlds", "resolution", "dt", "robot", "params"):
         if doc.get(key) is not None:
             kw[key] = doc[key]

@@ -44,7 +44,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
         plot_plan(
             grid, result, start, goal, args.plot,
             title=f"{grid.name}: {args.planner} {result.status.name} {result.length:.3f} m",
-            astar_points=result.info.get("astar_path"),
+            astar_points=result.info.get("astar_path"), robot_radius_m=args.robot_radius,
         )
     if args.json:
         d = result.to_dict()

@@ -31,8 +31,8 @@ from pathfuse.result import PlanResult  # noqa: E402
 __all__ = ["draw_map", "plot_plan", "map_legend_handles", "draw_astar", "PLANNER_COLOURS",
            "legend_below", "boxplot_key", "MEAN_PROPS"]
 
-MEAN_PROPS = {"marker": "^", "markerfacecolor": "#d62728", "markeredgecolor": "#d62728",
-              "markersize": 6}
+MEAN_PROPS: dict[str, Any] = {"marker": "^", "markerfacecolor": "#d62728",
+                              "markeredgecolor": "#d62728", "markersize": 6}
 """How every box plot draws its mean (``boxplot(..., showmeans=True, meanprops=MEAN_PROPS)``)."""
 
 PLANNER_COLOURS = {
@@ -165,7 +165,8 @@ def boxplot_key(fig: Any, fontsize: float = 8) -> Any:
     handles = [
         Patch(facecolor="white", edgecolor="k", label="box: middle 50 % (quartiles)"),
         Line2D([], [], color="#ff7f0e", label="line: median"),
-        Line2D([], [], ls="none", **{k: v for k, v in MEAN_PROPS.items()}, label="mean"),
+        Line2D([], [], ls="none", marker="^", mfc=MEAN_PROPS["markerfacecolor"],
+               mec=MEAN_PROPS["markeredgecolor"], ms=MEAN_PROPS["markersize"], label="mean"),
         Line2D([], [], color="k", marker="|", ms=8, label="whiskers: last value within "
                "1.5 IQR of the box"),
         Line2D([], [], ls="none", marker="o", mfc="none", mec="k", ms=4,

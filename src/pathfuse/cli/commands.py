@@ -203,7 +203,9 @@ def cmd_paper(args: argparse.Namespace) -> int:
     n_runs = len(run.records)
     sm = run.summary
     print(f"{n_runs} runs on {cfg.n_seeds} maps: {sm.ran} run now in {run.wall_s:.2f} s "
-          f"({sm.runs_per_s:.0f} runs/s, {sm.workers} worker{'s' if sm.workers != 1 else ''})"
+          f"({sm.runs_per_s:.0f} runs/s, {sm.workers} worker{'s' if sm.workers != 1 else ''}"
+          + (f", {sm.compile_s:.1f} s of it compiling kernels" if sm.compile_s >= 1.0 else "")
+          + ")"
           + (f", {sm.skipped} already in {sm.db_path}" if sm.skipped else ""))
     print(f"{'planner':<8} {'success':>12} {'length mean':>12} {'R_length':>10} {'time mean':>11}")
     for r in summary_rows(run):

@@ -205,7 +205,7 @@ def _bench(tmp_path, *extra):
     (tmp_path / "seg.py").write_text(SEGMENT)
     (tmp_path / "slow.yaml").write_text(SLOW)
     cmd = [sys.executable, "-m", "pathfuse.cli", "bench", "slow.yaml", "--db", "s.db",
-           "--batch-size", "2", *extra]
+           "--batch-size", "2", "--no-progress", *extra]  # stderr: the messages alone
     return subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True), cmd
 

@@ -57,7 +57,7 @@ from matplotlib.patches import Circle, Patch  # noqa: E402
 
 from pathfuse.result import PathfuseError  # noqa: E402
 from pathfuse.viz.dynamic import ONLINE_COLOURS, plot_success_vs_moving  # noqa: E402,F401
-from pathfuse.viz.figures import draw_map  # noqa: E402
+from pathfuse.viz.figures import draw_map, map_legend_handles  # noqa: E402
 
 __all__ = [
     "AnimationError",
@@ -198,7 +198,7 @@ class _EpisodeRenderer:
         self.fig = fig
         ax = fig.add_axes((max(left, (fw - aw) / 2 + 0.2) / fw, foot / fh, aw / fw, ah / fh))
         self.ax = ax
-        draw_map(ax, grid)
+        drawn = draw_map(ax, grid)
         ax.tick_params(labelsize=9)
         ax.xaxis.label.set_fontsize(9)
         ax.yaxis.label.set_fontsize(9)
@@ -266,6 +266,7 @@ class _EpisodeRenderer:
             Patch(fc="#ff7f0e", ec="#8a4500", label="moving obstacle (sensed)"),
             Patch(fc="#f4d3b0", ec="#8a4500", label="moving obstacle"),
             Line2D([], [], marker="*", ls="none", color="#ffbf00", mec="k", ms=9, label="goal"),
+            *map_legend_handles(drawn)[1:],  # unknown cells of a ROS map, when there are any
         ]
         fig.legend(handles=handles, loc="lower center", ncol=4 if fw >= 7 else 3, fontsize=9,
                    frameon=False, handlelength=1.6, columnspacing=1.0,

@@ -125,9 +125,10 @@ def plot_parameter(param: str, lines: Mapping[str, Sequence[Mapping[str, Any]]],
     a1.set_ylabel("success rate [%] (95% Wilson CI)")
     a1.set_ylim(-3, 103)
     a2.set_ylabel("path length mean [m] (95% t CI, solved runs)")
-    if k > 1:
-        a1.legend(fontsize=8)
+    if k > 1:  # under the plots, never over their points
+        fig.legend(*a1.get_legend_handles_labels(), loc="lower center", fontsize=8,
+                   ncol=min(k, 4), frameon=False)
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.1 if k > 1 else 0, 1, 1))
     fig.savefig(out, dpi=dpi)
     plt.close(fig)

@@ -76,6 +76,7 @@ def test_plan_reports_failure_status_with_exit_1():
         (["plan", "--map", "paper", "--resolution", "abc"], ["--resolution"]),
         (["scen", DATA / "movingai" / "den312d.map", "missing.scen"], ["missing.scen"]),
         (["paper", "--seeds", "0"], ["--seeds"]),
+        (["paper", "--variant", "matlab"], ["--variant", "matlab"]),
     ],
 )
 def test_bad_input_is_one_line_and_nonzero(args, fragments):
@@ -124,3 +125,21 @@ def test_negative_coordinates_are_accepted_on_a_ros_map():
     d = json.loads(p.stdout)
     assert d["status"] == "SUCCESS"
     assert d["path"][0] == pytest.approx([-1.025, -0.525])  # centre of the start cell
+
+
+def test_paper_variant_and_corner_cutting(tmp_path):
+    out = tmp_path / "p"
+    p = run("paper", "--seeds", "3", "--variant", "paper", "--corner-cutting", "--workers", "1",
+            "--out", out, "--quiet")
+    assert p.returncode == 0, p.stderr
+    assert "fusion/paper" in p.stdout and "shortest" in p.stdout
+    md = (out / "tables.md").read_text()
+    assert "paper variant: path length" in md and "pathfuse variant" not in md
+    assert "A-star (corner cutting)" in md and "with corner cutting" in md
+    assert "Excess over the shortest path" in md
+    p = run("paper", "--seeds", "2", "--variant", "pathfuse", "--no-references", "--workers",
+            "1", "--out", tmp_path / "q", "--quiet")
+    assert p.returncode == 0, p.stderr
+    md = (tmp_path / "q" / "tables.md").read_text()
+    assert "Theta*" not in md and "Excess" not in md and "fusion/paper" not in md
+

@@ -206,7 +206,10 @@ def test_segment_clear_agrees_with_independent_metrics(seed, ax, ay, dx, dy, cle
     seg = np.array([[ax, ay], [ax + dx, ay + dy]])
     got = segment_is_clear(ax, ay, ax + dx, ay + dy, g.occupied, 0.0, 0.0, 1.0, clear)
     x0, y0, x1, y1 = g.bounds
-    inside = bool(np.all((seg >= [x0 + clear, y0 + clear]) & (seg <= [x1 - clear, y1 - clear])))
+    # the margin (MARGIN_FRAC of a cell) is kept from occupied squares, not from the map's
+    # edge: a robot keeps its radius from the edge and may touch it (issue 9)
+    edge = max(clear - MARGIN_FRAC * 1.0, 0.0)
+    inside = bool(np.all((seg >= [x0 + edge, y0 + edge]) & (seg <= [x1 - edge, y1 - edge])))
     cl = min_clearance(g, seg)
     if abs(cl - clear) < 1e-9:
         return  # on the boundary of the test: either answer is right

@@ -93,7 +93,7 @@ def test_file_errors(tmp_path):
         read_rows_yaml(tmp_path / "no.yaml")
     p = tmp_path / "s.yaml"
     p.write_text("rows: ['..', \n")
-    with pytest.raises(MapFormatError, match=r"s\.yaml, line \d+, column \d+: YAML syntax"):
+    with pytest.raises(MapFormatError, match=r"s\.yaml: line \d+, column \d+: invalid YAML"):
         read_rows_yaml(p)
 
 

@@ -167,7 +167,7 @@ def test_spec_random_and_paper():
 @pytest.mark.parametrize(
     "spec, pattern",
     [
-        ({}, "exactly one of random, paper, movingai, ros, image, npy, rows; it has no"),
+        ({}, "exactly one of random, paper, movingai, ros, image, npy, rows, gazebo; it has no"),
         ({"rows": [".."], "paper": 1}, r"it has several \(paper, rows\)"),
         ({"rows": [".."], "colour": "red"}, "unknown key 'colour' in a 'rows' map spec"),
         ({"paper": 1, "resolution": 2}, "unknown key 'resolution' in a 'paper' map spec"),

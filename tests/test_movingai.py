@@ -251,6 +251,7 @@ def test_scen_missing_file(tmp_path):
         read_scen(tmp_path / "none.scen", g)
     p = tmp_path / "only_header.scen"
     p.write_text("version 1\n")
-    assert read_scen(p, g) == []
+    with pytest.raises(MapFormatError, match=r"only_header.scen: .*no problem line"):
+        read_scen(p, g)   # an empty benchmark is an error, not "0/0 match" (issue 9)
     with pytest.raises(MapFormatError, match="no problem line"):
         scen_map_name(p)

@@ -38,7 +38,7 @@ from pathfuse.world import (
 )
 from pathfuse.world.generate import generate_scenarios
 
-PLANNERS = ["fusion", "apf", "astar", "astar-replan", "ref6", "ref7"]
+PLANNERS = ["fusion", "apf", "astar", "astar-replan", "ref6", "ref7", "dwa"]
 HALL = ["." * 15] * 5
 
 
@@ -109,7 +109,8 @@ def _drive(doc, planner, params=None, seed=None):
 # ----------------------------------------------------------------------------- registry
 def test_registry_names_and_parameter_errors():
     # one registry: every built-in planner runs online
-    assert sorted(n for n in planner_names() if get_planner(n).online) == sorted(PLANNERS)
+    assert set(PLANNERS) <= {n for n in planner_names() if get_planner(n).online}
+    assert all(get_planner(n).online for n in planner_names())
     assert all(get_planner(n).offline for n in PLANNERS)
     with pytest.raises(ConfigError, match=r"^planner.name: unknown planner 'dstar'"):
         simulate(head_on(), planner="dstar")
@@ -378,8 +379,10 @@ def test_planners_get_the_static_context_and_current_observations_only():
     assert set(inspect.signature(Controller.__init__).parameters) == \
         {"self", "problem", "params", "plan", "dt", "max_speed"}
     assert {f.name for f in dataclasses.fields(Problem)} == \
-        {"grid", "start", "goal", "robot_radius_m", "budget", "start_cell", "goal_cell"}
+        {"grid", "start", "goal", "robot_radius_m", "budget", "start_cell", "goal_cell",
+         "clearance_m", "robot"}
     pb = spy.problem
+    assert pb.robot == sc.robot.to_model() and pb.clearance_m == sc.robot.clearance
     assert pb.grid is sc.grid and pb.start == sc.start and pb.goal == sc.goal
     assert pb.robot_radius_m == sc.robot.radius
     assert (spy.dt, spy.max_speed, spy.online, spy.plan) == (sc.dt, sc.robot.max_speed, True,

@@ -457,3 +457,34 @@ def test_config_names_and_parameter_columns(study):
     for cfg, settings in sql(db, "SELECT name, settings FROM plannerConfigs "
                                  "WHERE planner = 'fusion'"):
         assert f"{json.loads(settings)['r1_m']:g}" in cfg
+
+
+def test_excess_over_the_shortest_path_column(tmp_path):
+    exp = tmp_path / "exp.yaml"
+    exp.write_text("""
+seeds: 4
+maps:
+  - {name: paper, map: paper}
+planners: [astar, thetastar, shortest]
+""")
+    db = tmp_path / "s.db"
+    run_bench(exp, db, workers=1)
+    rep = build_report(db)
+    con = sqlite3.connect(db)
+    rows = con.execute(
+        "SELECT c.name, r.seed, r.solution_length FROM runs r JOIN plannerConfigs c "
+        "ON r.plannerid = c.id WHERE r.solved = 1").fetchall()
+    low = {seed: length for name, seed, length in rows if name == "shortest"}
+    by = {r["config"]: r for r in rep.rows if r["scope"] == "paper"}
+    for name in ("astar", "thetastar"):
+        want = [(length - low[seed]) / low[seed] for n, seed, length in rows if n == name]
+        assert by[name]["excess_pairs"] == 4
+        assert by[name]["excess_mean"] == pytest.approx(np.mean(want))
+        assert by[name]["excess_median"] == pytest.approx(np.median(want))
+        assert min(want) > 0
+    assert by["shortest"]["excess_pairs"] == 0
+    files = write_report(db, tmp_path / "rep")
+    md = Path(files["markdown"]).read_text() if "markdown" in files else \
+        (tmp_path / "rep" / "report.md").read_text()
+    assert "excess over the shortest path" in md
+

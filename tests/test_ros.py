@@ -294,7 +294,7 @@ def test_missing_yaml(tmp_path):
 def test_yaml_syntax_error_names_file_and_line(tmp_path):
     p = tmp_path / "bad.yaml"
     p.write_text("image: m.png\nresolution: [0.05\norigin: [0, 0, 0]\n")
-    with pytest.raises(MapFormatError, match=r"bad\.yaml, line \d+, column \d+: YAML syntax"):
+    with pytest.raises(MapFormatError, match=r"bad\.yaml: line \d+, column \d+: invalid YAML"):
         read_ros_map(p)
 
 

@@ -106,7 +106,15 @@ MALFORMED = [
     ("robot.radius", -0.1, "robot.radius: must be a number >= 0"),
     ("robot.max_speed", 0, "robot.max_speed: must be a number > 0"),
     ("robot.sensing_radius", "far", "robot.sensing_radius: must be a number > 0"),
-    ("robot.size", 1, "robot.size: unknown key (allowed: radius, max_speed, sensing_radius)"),
+    ("robot.size", 1, "robot.size: unknown key (allowed: radius, max_speed, sensing_radius, "
+                      "model, max_accel, max_yaw_rate, max_yaw_accel, min_speed, clearance, "
+                      "heading)"),
+    ("robot.model", "tank", "robot.model: must be one of 'holonomic', 'diff-drive', got 'tank'"),
+    ("robot.max_accel", 0, "robot.max_accel: must be a number > 0"),
+    ("robot.max_yaw_rate", "fast", "robot.max_yaw_rate: must be a number > 0"),
+    ("robot.min_speed", 0.5, "robot.min_speed: must be a number <= 0"),
+    ("robot.min_speed", -0.5, "robot.min_speed: only a diff-drive robot reverses"),
+    ("robot.clearance", -0.1, "robot.clearance: must be a number >= 0"),
     ("obstacles", {"a": 1}, "obstacles: must be a list"),
     ("obstacles[0]", 5, "obstacles[0]: must be a mapping"),
     ("obstacles[0].velocity", [0.5], "obstacles[0].velocity: must be two numbers"),
@@ -173,9 +181,9 @@ def test_file_errors_name_the_file_and_line():
         load_scenario(DATA / "bad_speed.yaml")
     assert str(info.value) == (f"{DATA / 'bad_speed.yaml'}: obstacles[1].speed: must be a "
                                f"number > 0, got 'fast'")
-    with pytest.raises(MapFormatError, match=r"bad_syntax.yaml, line 3, column 5"):
+    with pytest.raises(MapFormatError, match=r"bad_syntax.yaml: line 3, column 5"):
         load_scenario(DATA / "bad_syntax.yaml")
-    with pytest.raises(MapFormatError, match=r"duplicate_key.yaml, line 4.*duplicate key 'start'"):
+    with pytest.raises(MapFormatError, match=r"duplicate_key.yaml: line 4.*duplicate key 'start'"):
         load_scenario(DATA / "duplicate_key.yaml")
     with pytest.raises(ScenarioError, match=r"list.yaml: a scenario must be a mapping"):
         load_scenario(DATA / "list.yaml")

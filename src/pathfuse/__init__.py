@@ -31,6 +31,7 @@ _EXPORTS: dict[str, str] = {
     "QueryError": "pathfuse.result",
     "ConfigError": "pathfuse.result",
     "PlanningFailed": "pathfuse.result",
+    "LimitError": "pathfuse.limits",
     "REGISTRY": "pathfuse.planners.registry",
     "PlannerSpec": "pathfuse.planners.registry",
     "get_planner": "pathfuse.planners.registry",
@@ -65,6 +66,7 @@ __all__ = [
     "QueryError",
     "ConfigError",
     "PlanningFailed",
+    "LimitError",
     "REGISTRY",
     "PlannerSpec",
     "get_planner",
@@ -116,6 +118,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and IDEs
         write_movingai,
         write_ros_map,
     )
+    from pathfuse.limits import LimitError
     from pathfuse.planners.registry import (
         REGISTRY,
         PlannerSpec,

@@ -19,7 +19,9 @@ def plan(
     goal: object,
     planner: str = "astar",
     *,
-    robot_radius_m: float = 0.0,
+    robot_radius_m: float | None = None,
+    clearance_m: float = 0.0,
+    robot: Any = None,
     budget: Budget | None = None,
     **params: Any,
 ) -> PlanResult:
@@ -38,9 +40,18 @@ def plan(
     planner : str
         A name from :func:`pathfuse.planner_names` (``pathfuse planners``).
     robot_radius_m : float
-        Radius of a disc robot (default 0: a point).  The global planner
-        searches the map with obstacles and the map's edge grown by it, and
-        every move keeps that clearance.
+        Radius of a disc robot (default 0: a point; with ``robot``, its
+        radius).  The global planner searches the map with obstacles and the
+        map's edge grown by it, and every move keeps that clearance.
+    clearance_m : float
+        A soft safety margin beyond the radius (ours; default 0 = off): A*
+        pays an extra cost near obstacles and the controllers keep the
+        margin where they can.  ``info["min_clearance_m"]`` reports the
+        least clearance of the path's disc (checked independently).
+    robot : RobotModel, optional
+        The robot's kinematics (:class:`pathfuse.robot.RobotModel`); used by
+        the controllers that drive a model offline (``dwa``; default: a
+        diff-drive robot with :data:`pathfuse.robot.DIFF_DRIVE_DEFAULTS`).
     budget : Budget, optional
         Iteration and time caps; every planner also has finite defaults.
     **params
@@ -79,4 +90,7 @@ def plan(
     """
     spec = get_planner(planner)
     cfg = make_params(spec, params)
-    return solve(spec, Problem.create(grid, start, goal, robot_radius_m, budget), cfg)
+    if robot_radius_m is None:
+        robot_radius_m = getattr(robot, "radius_m", 0.0)
+    return solve(spec, Problem.create(grid, start, goal, robot_radius_m, budget, clearance_m,
+                                      robot), cfg)

@@ -40,7 +40,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from pathfuse.grid import GridMap
+from pathfuse.limits import check_cells
 from pathfuse.result import ConfigError, MapError
+from pathfuse.validate import short as _shown
 
 __all__ = [
     "paper_map",
@@ -71,6 +73,9 @@ _DEFAULT_MAX_ATTEMPTS = 1000
 
 def _cells_of(size: float, resolution: float, axis: str) -> int:
     n = size / resolution
+    if not math.isfinite(n):
+        raise MapError(f"map {axis} size {size:g} m at {resolution:g} m cells is not a finite "
+                       "number of cells")
     k = int(round(n))
     if k < 1 or abs(n - k) > 1e-6 * max(1.0, n):
         raise MapError(
@@ -86,9 +91,9 @@ def _point_cell(grid_shape: tuple[int, int], origin: tuple[float, float], resolu
         # any iterable of two numbers; a TypeError is reported below
         x, y = (float(v) for v in p)  # type: ignore[attr-defined]
     except (TypeError, ValueError):
-        raise MapError(f"{what} must be an (x, y) pair of numbers, got {p!r}") from None
+        raise MapError(f"{what} must be an (x, y) pair of numbers, got {_shown(p)}") from None
     if not (math.isfinite(x) and math.isfinite(y)):
-        raise MapError(f"{what} must be finite, got {p!r}")
+        raise MapError(f"{what} must be finite, got {_shown(p)}")
     col = math.floor((x - origin[0]) / resolution)
     row = math.floor((y - origin[1]) / resolution)
     h, w = grid_shape
@@ -168,43 +173,47 @@ def random_map(
     if (obstacles is None) == (density is None):
         raise ConfigError("give exactly one of obstacles (a count) and density (a fraction)")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+        raise ConfigError(f"seed must be a non-negative integer, got {_shown(seed)}")
     if isinstance(max_attempts, bool) or not isinstance(max_attempts, (int, np.integer)) \
             or max_attempts < 1:
-        raise ConfigError(f"max_attempts must be a positive integer, got {max_attempts!r}")
+        raise ConfigError(f"max_attempts must be a positive integer, got {_shown(max_attempts)}")
     try:
         res = float(resolution)
     except (TypeError, ValueError):
-        raise MapError(f"resolution must be a number, got {resolution!r}") from None
+        raise MapError(f"resolution must be a number, got {_shown(resolution)}") from None
     if not math.isfinite(res) or res <= 0:
-        raise MapError(f"resolution must be a finite number > 0, got {resolution!r}")
+        raise MapError(f"resolution must be a finite number > 0, got {_shown(resolution)}")
     try:
         sizes = np.broadcast_to(np.asarray(size_m, dtype=np.float64), (2,))
     except (TypeError, ValueError):
-        raise MapError(f"size_m must be a number or (width, height) in metres, got {size_m!r}") \
+        raise MapError(f"size_m must be a number or (width, height) in metres, got"
+                       f" {_shown(size_m)}") \
             from None
     if not np.all(np.isfinite(sizes)) or np.any(sizes <= 0):
-        raise MapError(f"size_m must be finite and > 0, got {size_m!r}")
+        raise MapError(f"size_m must be finite and > 0, got {_shown(size_m)}")
     width = _cells_of(float(sizes[0]), res, "width")
     height = _cells_of(float(sizes[1]), res, "height")
     try:
         ox, oy = (float(v) for v in origin)
     except (TypeError, ValueError):
-        raise MapError(f"origin must be two numbers (x, y), got {origin!r}") from None
+        raise MapError(f"origin must be two numbers (x, y), got {_shown(origin)}") from None
     n_cells = width * height
+    check_cells(height, width, f"random map {float(sizes[0]):g} m x {float(sizes[1]):g} m "
+                f"at {res:g} m")
 
     if obstacles is not None:
         if isinstance(obstacles, bool) or not isinstance(obstacles, (int, np.integer)) \
                 or obstacles < 0:
-            raise ConfigError(f"obstacles must be a non-negative integer, got {obstacles!r}")
+            raise ConfigError(f"obstacles must be a non-negative integer, got {_shown(obstacles)}")
         count = int(obstacles)
     else:
         try:
             d = float(density)  # type: ignore[arg-type]
         except (TypeError, ValueError):
-            raise ConfigError(f"density must be a number in [0, 1], got {density!r}") from None
+            raise ConfigError(f"density must be a number in [0, 1], got"
+                              f" {_shown(density)}") from None
         if not (0.0 <= d <= 1.0):
-            raise ConfigError(f"density must be in [0, 1], got {density!r}")
+            raise ConfigError(f"density must be in [0, 1], got {_shown(density)}")
         count = int(math.floor(d * n_cells + 0.5))
 
     shape = (height, width)
@@ -216,7 +225,7 @@ def random_map(
         try:
             a, b = pair
         except (TypeError, ValueError):
-            raise MapError(f"connect entries must be pairs of points, got {pair!r}") from None
+            raise MapError(f"connect entries must be pairs of points, got {_shown(pair)}") from None
         ca = _point_cell(shape, (ox, oy), res, a, "connect point")
         cb = _point_cell(shape, (ox, oy), res, b, "connect point")
         kept.update((ca, cb))

@@ -115,12 +115,19 @@ def segment_box_distance(ax, ay, bx, by, x0, y0, x1, y1):
 
 @njit(cache=True)
 def segment_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear):
-    """True when segment ``AB`` stays ``>= clear`` from every occupied square and the map edge."""
+    """True when segment ``AB`` stays ``>= clear`` from every occupied square and inside the
+    map, at least ``clear - MARGIN_FRAC * res`` (the robot's radius) from its edge.
+
+    The map's edge is not an obstacle: a robot may touch it (and a point robot may stand
+    and move on it, the lower and left edges being part of the map), so the margin that
+    keeps a robot from *touching* an occupied square is not kept from the edge.
+    """
     h, w = occ.shape
-    xmin = ox + clear
-    ymin = oy + clear
-    xmax = ox + w * res - clear
-    ymax = oy + h * res - clear
+    edge = max(clear - MARGIN_FRAC * res, 0.0)
+    xmin = ox + edge
+    ymin = oy + edge
+    xmax = ox + w * res - edge
+    ymax = oy + h * res - edge
     if not (xmin <= ax <= xmax and xmin <= bx <= xmax and ymin <= ay <= ymax
             and ymin <= by <= ymax):
         return False

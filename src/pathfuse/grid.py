@@ -31,12 +31,17 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
+from pathfuse.limits import MAX_EXTENT_M
 from pathfuse.result import MapError
+from pathfuse.validate import short as _shown
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
 __all__ = ["GridMap"]
+
+_KERNEL_MAX = 24
+"""Inflation kernels wider than this many cells each side use the distance transform."""
 
 
 def _as_points(xy: object, what: str = "point") -> np.ndarray:
@@ -89,7 +94,7 @@ class GridMap:
         if occ.ndim != 2:
             raise MapError(f"occupancy must be a 2-D array, got shape {occ.shape}")
         if occ.size == 0:
-            raise MapError(f"map {self.name!r} is empty (shape {occ.shape})")
+            raise MapError(f"map {_shown(self.name)} is empty (shape {occ.shape})")
         if occ.dtype != np.bool_:
             if not np.issubdtype(occ.dtype, np.number):
                 raise MapError(f"occupancy must be boolean or numeric, got dtype {occ.dtype}")
@@ -100,16 +105,24 @@ class GridMap:
         try:
             res = float(self.resolution)
         except (TypeError, ValueError):
-            raise MapError(f"resolution must be a number, got {self.resolution!r}") from None
+            raise MapError(f"resolution must be a number, got {_shown(self.resolution)}") from None
         if not np.isfinite(res) or res <= 0:
-            raise MapError(f"resolution must be a finite number > 0, got {self.resolution!r}")
+            raise MapError(f"resolution must be a finite number > 0, got {_shown(self.resolution)}")
         object.__setattr__(self, "resolution", res)
         try:
             ox, oy = (float(v) for v in self.origin)
         except (TypeError, ValueError):
-            raise MapError(f"origin must be two numbers (x, y), got {self.origin!r}") from None
+            raise MapError(f"origin must be two numbers (x, y), got"
+                           f" {_shown(self.origin)}") from None
         if not (np.isfinite(ox) and np.isfinite(oy)):
-            raise MapError(f"origin must be finite, got {self.origin!r}")
+            raise MapError(f"origin must be finite, got {_shown(self.origin)}")
+        h, w = occ.shape
+        far = max(abs(ox), abs(oy), abs(ox + w * res), abs(oy + h * res))
+        if not far <= MAX_EXTENT_M:
+            raise MapError(
+                f"the map reaches {far:.3g} m from the world origin (resolution {res:g} m, "
+                f"origin ({ox:g}, {oy:g}), {h} x {w} cells); pathfuse works within "
+                f"{MAX_EXTENT_M:g} m (MAX_EXTENT_M)")
         object.__setattr__(self, "origin", (ox, oy))
 
     # ------------------------------------------------------------------ builders
@@ -126,8 +139,13 @@ class GridMap:
 
         ``blocked`` characters are obstacles, every other character is free.
         """
+        if isinstance(rows, (str, bytes)) or not isinstance(rows, (list, tuple)):
+            raise MapError(f"rows must be a list of strings, got {_shown(rows)}")
         if not rows:
             raise MapError("rows must hold at least one row")
+        for i, r in enumerate(rows):
+            if not isinstance(r, str):
+                raise MapError(f"rows[{i}] must be a string, got {_shown(r)}")
         widths = {len(r) for r in rows}
         if len(widths) != 1:
             raise MapError(f"rows must all have the same length, got lengths {sorted(widths)}")
@@ -227,7 +245,7 @@ class GridMap:
         """
         r = float(radius_m)
         if not np.isfinite(r) or r < 0:
-            raise MapError(f"inflation radius must be a finite number >= 0, got {radius_m!r}")
+            raise MapError(f"inflation radius must be a finite number >= 0, got {_shown(radius_m)}")
         cache = self._inflated
         if r not in cache:
             if len(cache) >= 8:
@@ -255,7 +273,7 @@ class GridMap:
         """
         r = float(radius_m)
         if not math.isfinite(r) or r < 0:
-            raise MapError(f"robot radius must be a finite number >= 0, got {radius_m!r}")
+            raise MapError(f"robot radius must be a finite number >= 0, got {_shown(radius_m)}")
         if r == 0:
             return self
         key = ("cspace", r)
@@ -263,6 +281,12 @@ class GridMap:
         if key not in cache:
             if len(cache) >= 8:
                 cache.pop(next(iter(cache)))
+            if r > min(self.shape) * self.resolution / 2:
+                # every cell centre is closer than r to the map's edge: nothing is free (and
+                # no padding as wide as the radius is allocated)
+                cache[key] = self.with_occupied(np.ones_like(self.occupied),
+                                                name=f"{self.name}+r{r:g}")
+                return cache[key]  # type: ignore[return-value]
             k = int(math.ceil(r / self.resolution + 0.5)) + 1
             padded = np.pad(self.occupied, k, constant_values=True)
             res = self.resolution
@@ -274,17 +298,46 @@ class GridMap:
     def _inflate(self, r: float) -> GridMap:
         if r == 0 or not self.occupied.any():
             return self.with_occupied(self.occupied.copy())
+        h, w = self.shape
+        if r > math.hypot(h, w) * self.resolution:
+            # farther than the map's diagonal: every cell is within r of every obstacle
+            return self.with_occupied(np.ones_like(self.occupied), name=f"{self.name}+r{r:g}")
         # distance from a cell centre to the nearest point of an occupied square
         # = distance to the square's centre shrunk by half a cell on each axis.
         k = int(np.ceil(r / self.resolution + 0.5))
-        d = np.arange(-k, k + 1, dtype=np.float64)
-        dx = np.maximum(np.abs(d)[None, :] - 0.5, 0.0)
-        dy = np.maximum(np.abs(d)[:, None] - 0.5, 0.0)
-        footprint = np.hypot(dx, dy) * self.resolution < r
+        if k > _KERNEL_MAX:
+            grown = self._inflate_far(r)
+        else:
+            d = np.arange(-k, k + 1, dtype=np.float64)
+            dx = np.maximum(np.abs(d)[None, :] - 0.5, 0.0)
+            dy = np.maximum(np.abs(d)[:, None] - 0.5, 0.0)
+            footprint = np.hypot(dx, dy) * self.resolution < r
+            from scipy import ndimage
+
+            grown = ndimage.binary_dilation(self.occupied, structure=footprint)
+        return self.with_occupied(grown | self.occupied, name=f"{self.name}+r{r:g}")
+
+    def _inflate_far(self, r: float) -> np.ndarray:
+        """Inflation by a radius wider than the dilation kernel allows, in time and memory
+        linear in the map (not in the radius): the nearest point of a square to a cell
+        centre is one of its corners or edge midpoints, all on the half-cell lattice, so
+        one exact distance transform of that lattice finds it."""
         from scipy import ndimage
 
-        grown = ndimage.binary_dilation(self.occupied, structure=footprint)
-        return self.with_occupied(grown | self.occupied, name=f"{self.name}+r{r:g}")
+        h, w = self.shape
+        lat = np.zeros((2 * h + 1, 2 * w + 1), dtype=bool)
+        rr, cc = np.nonzero(self.occupied)
+        for di in (0, 1, 2):
+            for dj in (0, 1, 2):
+                if di != 1 or dj != 1:
+                    lat[2 * rr + di, 2 * cc + dj] = True
+        idx = ndimage.distance_transform_edt(~lat, return_distances=False, return_indices=True)
+        ci = np.arange(1, 2 * h, 2)[:, None]
+        cj = np.arange(1, 2 * w, 2)[None, :]
+        # the same formula as the kernel's: half-cell offsets, hypot, times the resolution
+        dy = np.abs(idx[0][1::2, 1::2] - ci) * 0.5
+        dx = np.abs(idx[1][1::2, 1::2] - cj) * 0.5
+        return np.hypot(dx, dy) * self.resolution < r
 
     @cached_property
     def distance_field(self) -> np.ndarray:

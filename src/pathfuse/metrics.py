@@ -58,6 +58,7 @@ from pathfuse.metrics_kernels import (
     shape_kernel,
 )
 from pathfuse.result import ConfigError, PlanResult, QueryError
+from pathfuse.validate import short as _shown
 
 __all__ = [
     "path_length",
@@ -146,7 +147,8 @@ def _geometry(grid: GridMap, p: np.ndarray) -> tuple[float, bool]:
 def _radius(robot_radius_m: float) -> float:
     r = float(robot_radius_m)
     if not math.isfinite(r) or r < 0:
-        raise ConfigError(f"robot_radius_m: must be a finite number >= 0, got {robot_radius_m!r}")
+        raise ConfigError(f"robot_radius_m: must be a finite number >= 0, got"
+                          f" {_shown(robot_radius_m)}")
     return r
 
 
@@ -227,9 +229,10 @@ def r_ratio(a: float, b: float) -> float:
     a = float(a)
     b = float(b)
     if b == 0.0 or not math.isfinite(b):
-        raise ConfigError(f"r_ratio: the reference value must be non-zero and finite, got {b!r}")
+        raise ConfigError(f"r_ratio: the reference value must be non-zero and finite, got"
+                          f" {_shown(b)}")
     if not math.isfinite(a):
-        raise ConfigError(f"r_ratio: the value must be finite, got {a!r}")
+        raise ConfigError(f"r_ratio: the value must be finite, got {_shown(a)}")
     return (a - b) / b
 
 

@@ -29,6 +29,7 @@ from typing import Any
 
 from pathfuse.grid import GridMap
 from pathfuse.result import Budget, ConfigError, QueryError, Status
+from pathfuse.validate import short as _shown
 
 __all__ = ["Problem", "as_xy"]
 
@@ -46,7 +47,7 @@ def as_xy(value: object, what: str) -> tuple[float, float]:
     pathfuse.result.QueryError: goal: must be two numbers (x, y), got '12'
     """
     if isinstance(value, (str, bytes)):
-        raise QueryError(f"{what}: must be two numbers (x, y), got {value!r}")
+        raise QueryError(f"{what}: must be two numbers (x, y), got {_shown(value)}")
     x: Any
     y: Any
     try:
@@ -58,7 +59,7 @@ def as_xy(value: object, what: str) -> tuple[float, float]:
         shown = shown if len(shown) <= 60 else shown[:57] + "..."
         raise QueryError(f"{what}: must be two numbers (x, y), got {shown}") from None
     if not (math.isfinite(x) and math.isfinite(y)):
-        raise QueryError(f"{what}: must be finite, got {value!r}")
+        raise QueryError(f"{what}: must be finite, got {_shown(value)}")
     return x, y
 
 
@@ -81,6 +82,14 @@ class Problem:
     start_cell, goal_cell : (int, int)
         ``(row, col)`` of the cells the points lie in (may be outside the
         map: see :meth:`failure`).
+    clearance_m : float
+        The soft safety margin beyond the radius (ours; 0 = off): the global
+        planner pays for coming closer to an obstacle, the controllers keep
+        it where they can (see the README).
+    robot : RobotModel or None
+        The robot's kinematic model (:class:`pathfuse.robot.RobotModel`);
+        None: a holonomic robot (offline, the geometric planners ignore it;
+        ``dwa`` plans with a default diff-drive robot).
     """
 
     grid: GridMap
@@ -90,10 +99,13 @@ class Problem:
     budget: Budget = field(default=_DEFAULT_BUDGET)
     start_cell: tuple[int, int] = (0, 0)
     goal_cell: tuple[int, int] = (0, 0)
+    clearance_m: float = 0.0
+    robot: Any = None
 
     @classmethod
     def create(cls, grid: GridMap, start: object, goal: object, robot_radius_m: float = 0.0,
-               budget: Budget | None = None) -> Problem:
+               budget: Budget | None = None, clearance_m: float = 0.0,
+               robot: Any = None) -> Problem:
         """Check the input once and fix the cells (scalar arithmetic, no numpy per point).
 
         Raises
@@ -102,8 +114,9 @@ class Problem:
             ``grid`` is not a :class:`GridMap`, or ``start``/``goal`` is not a
             pair of finite numbers.
         ConfigError
-            ``robot_radius_m`` is not a finite number >= 0, or ``budget`` is
-            not a :class:`Budget`.
+            ``robot_radius_m`` or ``clearance_m`` is not a finite number >= 0,
+            ``budget`` is not a :class:`Budget`, or ``robot`` is not a
+            :class:`~pathfuse.robot.RobotModel` of radius ``robot_radius_m``.
         """
         if not isinstance(grid, GridMap):
             raise QueryError(f"grid: must be a pathfuse.GridMap, got {type(grid).__name__}")
@@ -123,12 +136,28 @@ class Problem:
                 ok = False
             if not ok:
                 raise ConfigError(
-                    f"robot_radius_m: must be a finite number >= 0, got {robot_radius_m!r}")
+                    f"robot_radius_m: must be a finite number >= 0, got {_shown(robot_radius_m)}")
+        c = clearance_m
+        if c != 0.0:
+            if isinstance(c, bool) or not isinstance(c, (int, float)) or not math.isfinite(c) \
+                    or c < 0:
+                raise ConfigError(f"clearance_m: must be a finite number >= 0, got {_shown(c)}")
+            c = float(c)
+        if robot is not None:
+            from pathfuse.robot import RobotModel
+
+            if not isinstance(robot, RobotModel):
+                raise ConfigError(f"robot: must be a pathfuse.RobotModel, got "
+                                  f"{type(robot).__name__}")
+            if robot.radius_m != float(r):
+                raise ConfigError(f"robot: its radius_m ({robot.radius_m:g}) differs from "
+                                  f"robot_radius_m ({float(r):g})")
         ox, oy = grid.origin
         res = grid.resolution
         return cls(grid, s, g, float(r), budget,
                    (math.floor((s[1] - oy) / res), math.floor((s[0] - ox) / res)),
-                   (math.floor((g[1] - oy) / res), math.floor((g[0] - ox) / res)))
+                   (math.floor((g[1] - oy) / res), math.floor((g[0] - ox) / res)),
+                   c, robot)
 
     def failure(self) -> tuple[Status, str] | None:
         """``(status, message)`` when the start or goal cannot be planned from, else None.
@@ -162,6 +191,8 @@ class Problem:
         return None
 
     def _blocked(self, p: tuple[float, float], cell: tuple[int, int], what: str) -> str | None:
+        from numpy import shape as np_shape
+
         g = self.grid
         r, c = cell
         if g.occupied[r, c]:
@@ -182,8 +213,20 @@ class Problem:
             clear = self.robot_radius_m + MARGIN_FRAC * g.resolution
             if not segment_is_clear(p[0], p[1], p[0], p[1], g.occupied, ox, oy, g.resolution,
                                     clear):
+                x0, y0, x1, y1 = g.bounds
+                edge = min(p[0] - x0, x1 - p[0], p[1] - y0, y1 - p[1]) < self.robot_radius_m
+                unknown = g.meta.get("unknown")
+                if edge:
+                    hit = "the map's edge"
+                elif unknown is not None and np_shape(unknown) == g.occupied.shape and \
+                        segment_is_clear(p[0], p[1], p[0], p[1], g.occupied & ~unknown, ox, oy,
+                                         g.resolution, clear):
+                    hit = ("an unknown cell of the map (unknown cells are blocked; load the "
+                           "map with unknown='free' to plan through them)")
+                else:
+                    hit = "an occupied cell"
                 return (f"{what} ({p[0]:g}, {p[1]:g}): the robot (radius "
-                        f"{self.robot_radius_m:g} m) overlaps an occupied cell or the map's edge")
+                        f"{self.robot_radius_m:g} m) overlaps {hit}")
         return None
 
     def with_start(self, start: tuple[float, float]) -> Problem:
@@ -192,4 +235,4 @@ class Problem:
         res = self.grid.resolution
         return Problem(self.grid, start, self.goal, self.robot_radius_m, self.budget,
                        (math.floor((start[1] - oy) / res), math.floor((start[0] - ox) / res)),
-                       self.goal_cell)
+                       self.goal_cell, self.clearance_m, self.robot)

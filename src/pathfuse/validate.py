@@ -68,22 +68,39 @@ T = TypeVar("T")
 def short(value: Any, n: int = SHOWN) -> str:
     """``repr(value)`` cut to ``n`` characters (``...`` marks the cut).
 
-    Containers are not expanded beyond what is shown, so a deeply nested or
-    self-referencing value costs no more than ``n`` characters.
+    The cost is bounded whatever the value: containers are shown a few items
+    and levels deep (:mod:`reprlib`), so a deeply nested, self-referencing or
+    alias-expanded value costs no more than ``n`` characters.
 
     >>> short([1, 2, 3])
     '[1, 2, 3]'
+    >>> short([[[[[[1]]]]]])
+    '[[[[...]]]]'
     """
     if isinstance(value, (str, bytes)):
         text_ = repr(value[: n + 2])
-    elif isinstance(value, (list, tuple, dict, set)) and len(value) > n // 2:
-        text_ = f"<{type(value).__name__} of {len(value)} items>"
     else:
         try:
-            text_ = repr(value)
-        except RecursionError:
+            text_ = _REPR.repr(value)
+        except Exception:  # a broken __repr__ must not hide the real error
             text_ = f"<{type(value).__name__}>"
     return text_ if len(text_) <= n else text_[: n - 3] + "..."
+
+
+def _make_repr() -> Any:
+    import reprlib
+
+    r = reprlib.Repr()
+    r.maxlevel = 3
+    r.maxlist = r.maxtuple = r.maxset = r.maxfrozenset = r.maxdeque = r.maxarray = 8
+    r.maxdict = 6
+    r.maxstring = SHOWN
+    r.maxother = SHOWN
+    r.maxlong = 40
+    return r
+
+
+_REPR = _make_repr()
 
 
 def _fail(key: str, what: str, value: Any, error: type[ConfigError]) -> ConfigError:

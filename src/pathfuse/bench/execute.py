@@ -464,6 +464,9 @@ def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
     row["timing"] = json.dumps(timing, sort_keys=True)
     if store_paths and positions.shape[0]:
         row["path"] = _path_blob(positions)
+        headings = np.asarray(getattr(ep, "headings", ()), dtype=float).reshape(-1)
+        if headings.shape[0] == positions.shape[0]:
+            row["headings"] = np.ascontiguousarray(headings, dtype="<f8").tobytes()
     return row
 
 

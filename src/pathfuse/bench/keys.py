@@ -20,14 +20,16 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse.limits import MAX_SEED, check_count
 from pathfuse.result import Budget, ConfigError
+from pathfuse.validate import short as _shown
 
 KEY_VERSION = 1
 """Bumped only if the meaning of a run key changes (it never silently does)."""
 
 GENERATED_FAMILIES = ("paper", "random")
 """Map families drawn from a seed; without an explicit seed they take the run's."""
-FILE_FAMILIES = ("movingai", "ros", "image", "npy")
+FILE_FAMILIES = ("movingai", "ros", "image", "npy", "gazebo")
 """Map families read from a file (path relative to the experiment file)."""
 INLINE_FAMILIES = ("rows",)
 """Maps written inline in the experiment."""
@@ -131,24 +133,37 @@ def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
     def bad(msg: str) -> ConfigError:
         return ConfigError(f"{where}: {msg}")
 
+    def counted(start: int, count: int) -> tuple[int, ...]:
+        if start < 0 or start > MAX_SEED:
+            raise bad(f"seeds must be integers in [0, 2**63), got {_shown(start)}")
+        check_count(count, "MAX_RUNS", f"{where}: a seed count")
+        if start + count - 1 > MAX_SEED:
+            raise bad(f"seeds must be integers in [0, 2**63), got up to {start + count - 1}")
+        return tuple(range(start, start + count))
+
     if _is_int(value):
         if value < 1:
             raise bad(f"a seed count must be >= 1, got {value}")
-        return tuple(range(int(value)))
+        return counted(0, int(value))
     if isinstance(value, str):
         text = value.strip()
+        if len(text) > 100_000:
+            raise bad(f"a seed text of {len(text)} characters is too long; use 'A:B' or a count")
         try:
             if ":" in text:
                 a, b = (int(t) for t in text.split(":"))
-                seeds = tuple(range(a, b))
             else:
                 seeds = tuple(int(t) for t in text.split(",") if t.strip())
         except ValueError:
-            raise bad(f"expected 'A:B', 'A,B,C' or a count, got {value!r}") from None
+            raise bad(f"expected 'A:B', 'A,B,C' or a count, got {_shown(value)}") from None
+        if ":" in text:
+            if b <= a:
+                raise bad(f"{_shown(value)} holds no seed")
+            return counted(a, b - a)
         if not seeds:
-            raise bad(f"{value!r} holds no seed")
-        if min(seeds) < 0:
-            raise bad(f"seeds must be >= 0, got {value!r}")
+            raise bad(f"{_shown(value)} holds no seed")
+        if min(seeds) < 0 or max(seeds) > MAX_SEED:
+            raise bad(f"seeds must be integers in [0, 2**63), got {_shown(value)}")
         return seeds
     if isinstance(value, Mapping):
         unknown = set(value) - {"start", "count"}
@@ -156,20 +171,23 @@ def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
             raise bad(f"expected {{start: A, count: N}}, got {_short(dict(value))}")
         start, count = value.get("start", 0), value["count"]
         if not _is_int(start) or start < 0:
-            raise bad(f"start must be an integer >= 0, got {start!r}")
+            raise bad(f"start must be an integer >= 0, got {_shown(start)}")
         if not _is_int(count) or count < 1:
-            raise bad(f"count must be an integer >= 1, got {count!r}")
-        return tuple(range(int(start), int(start) + int(count)))
+            raise bad(f"count must be an integer >= 1, got {_shown(count)}")
+        return counted(int(start), int(count))
     if isinstance(value, (list, tuple)):
         if not value:
             raise bad("the seed list is empty")
+        check_count(len(value), "MAX_RUNS", f"{where}: a seed list")
         for i, s in enumerate(value):
-            if not _is_int(s) or s < 0:
-                raise ConfigError(f"{where}[{i}]: a seed must be an integer >= 0, got {s!r}")
+            if not _is_int(s) or s < 0 or s > MAX_SEED:
+                raise ConfigError(f"{where}[{i}]: a seed must be an integer in [0, 2**63), "
+                                  f"got {_shown(s)}")
         if len(set(value)) != len(value):
             raise bad("the seed list repeats a seed")
         return tuple(int(s) for s in value)
-    raise bad(f"expected a count, a list of integers, 'A:B' or {{start, count}}, got {value!r}")
+    raise bad(f"expected a count, a list of integers, 'A:B' or {{start, count}}, "
+              f"got {_shown(value)}")
 
 
 # --------------------------------------------------------------------------- entries
@@ -200,9 +218,9 @@ def _parse_limits(value: Any, where: str, base: Limits | None = None) -> Limits:
     t = value.get("time_limit_s", base.time_limit_s)
     m = value.get("max_iterations", base.max_iterations)
     if t is not None and (not _is_num(t) or float(t) <= 0):
-        raise ConfigError(f"{where}.time_limit_s: must be a number > 0, got {t!r}")
+        raise ConfigError(f"{where}.time_limit_s: must be a number > 0, got {_shown(t)}")
     if m is not None and (not _is_int(m) or m < 1):
-        raise ConfigError(f"{where}.max_iterations: must be an integer >= 1, got {m!r}")
+        raise ConfigError(f"{where}.max_iterations: must be an integer >= 1, got {_shown(m)}")
     return Limits(None if t is None else float(t), None if m is None else int(m))
 
 

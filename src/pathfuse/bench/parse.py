@@ -41,7 +41,9 @@ from pathfuse.bench.spec import (
     _load_for_expand,
     load_dynamic,
 )
+from pathfuse.limits import check_count
 from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.validate import short as _shown
 
 
 # --------------------------------------------------------------------------- parsing
@@ -63,34 +65,37 @@ def load_experiment(path: str | os.PathLike[str], seeds: Any = None,
     ConfigError
         One line: ``FILE: key.path: what is wrong``.
     """
+    from pathfuse.limits import read_capped
+
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        data = read_capped(p, "the experiment file", "MAX_YAML_BYTES")
     except FileNotFoundError:
         raise ConfigError(f"{p}: no such experiment file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{p}: cannot read experiment file ({exc})") from None
+    except OSError as exc:
+        raise ConfigError(f"{p}: cannot read experiment file ({exc.strerror or exc})") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{p}: not a UTF-8 text file ({exc.reason} at byte {exc.start})") \
+            from None
     return parse_experiment(text, p, seeds=seeds, check_maps=check_maps)
 
 
 def parse_experiment(text: str, path: str | os.PathLike[str] = "experiment.yaml",
                      seeds: Any = None, check_maps: bool = True) -> Experiment:
     """Validate experiment YAML ``text`` (``path`` names it and anchors relative paths)."""
+    from pathfuse.safeyaml import load_yaml
+
     path = Path(path)
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise ConfigError(f"{path}: {where}invalid YAML: {problem}") from None
+    doc = load_yaml(text, str(path), ConfigError)
     try:
         return _parse(doc, path, text, seeds, check_maps)
     except ConfigError as exc:
         msg = str(exc)
         if not msg.startswith(str(path)):
             msg = f"{path}: {msg}"
-        raise ConfigError(msg) from None
+        raise type(exc)(msg) from None
 
 
 def experiment_from_dict(doc: Mapping[str, Any], path: str | os.PathLike[str],
@@ -116,7 +121,7 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
             raise ConfigError(f"{k}: unknown key; expected one of {', '.join(_TOP_KEYS)}")
     name = doc.get("name", path.stem)
     if not isinstance(name, str) or not name.strip():
-        raise ConfigError(f"name: must be a non-empty string, got {name!r}")
+        raise ConfigError(f"name: must be a non-empty string, got {_shown(name)}")
     desc = doc.get("description", "") or ""
     if not isinstance(desc, str):
         raise ConfigError(f"description: must be a string, got {_short(desc)}")
@@ -128,7 +133,7 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
     radius = _radius(doc.get("robot_radius_m", 0.0), "robot_radius_m")
     store_paths = doc.get("store_paths", False)
     if not isinstance(store_paths, bool):
-        raise ConfigError(f"store_paths: must be true or false, got {store_paths!r}")
+        raise ConfigError(f"store_paths: must be true or false, got {_shown(store_paths)}")
     imports = doc.get("imports", []) or []
     if isinstance(imports, str):
         imports = [imports]
@@ -159,7 +164,7 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
         entry = _parse_map(i, v, top_seeds, radius, exp_dir,
                            seeds_override is not None)
         if entry.name in names:
-            raise ConfigError(f"maps[{i}].name: {entry.name!r} is already the name of "
+            raise ConfigError(f"maps[{i}].name: {_shown(entry.name)} is already the name of "
                               f"maps[{names[entry.name]}]")
         names[entry.name] = i
         maps.append(entry)
@@ -207,7 +212,7 @@ def _do_imports(imports: Sequence[str], base_dir: Path) -> None:
 
 def _radius(v: Any, where: str) -> float:
     if not _is_num(v) or float(v) < 0:
-        raise ConfigError(f"{where}: must be a number >= 0 (metres), got {v!r}")
+        raise ConfigError(f"{where}: must be a number >= 0 (metres), got {_shown(v)}")
     return float(v)
 
 
@@ -247,7 +252,7 @@ class _Registry:
 
         spec = get_planner(name)
         if self.kind == "dynamic" and not spec.online:
-            raise ConfigError(f"planner {spec.name!r} only plans offline; it cannot run on a "
+            raise ConfigError(f"planner {_shown(spec.name)} only plans offline; it cannot run on a "
                               "dynamic entry")
         return spec
 
@@ -306,10 +311,10 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
             except ConfigError as exc:
                 raise ConfigError(f"{where}.name: {exc}") from None
         choices = "; ".join(f"{k}: {', '.join(_registry(k).names())}" for k in kinds)
-        raise ConfigError(f"{where}.name: unknown planner {name!r} (choose from {choices})")
+        raise ConfigError(f"{where}.name: unknown planner {_shown(name)} (choose from {choices})")
     label = v.get("label")
     if label is not None and (not isinstance(label, str) or not label.strip()):
-        raise ConfigError(f"{where}.label: must be a non-empty string, got {label!r}")
+        raise ConfigError(f"{where}.label: must be a non-empty string, got {_shown(label)}")
     raw = v.get("params") or {}
     if not isinstance(raw, Mapping):
         raise ConfigError(f"{where}.params: expected a mapping of parameter: value or "
@@ -327,7 +332,7 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         for kind, sp in specs.items():
             if k not in fields_by_kind[kind]:
                 what = "online planner" if kind == "dynamic" else "planner"
-                raise ConfigError(f"{kw}: {what} {sp.name!r} has no such parameter; its "
+                raise ConfigError(f"{kw}: {what} {_shown(sp.name)} has no such parameter; its "
                                   f"parameters are: {', '.join(sorted(fields_by_kind[kind]))}")
         values = list(val) if isinstance(val, list) else [val]
         if not values:
@@ -343,6 +348,12 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         if len(set(map(canonical_json, vals))) != len(vals):
             raise ConfigError(f"{kw}: the list of values repeats a value")
         params.append((str(k), tuple(_plain(list(vals)))))
+    n_combos = 1
+    for _, vals in params:
+        n_combos *= len(vals)
+    if n_combos > 1:
+        grid = " x ".join(str(len(vals)) for _, vals in params if len(vals) > 1)
+        check_count(n_combos, "MAX_RUNS", f"{where}.params: the parameter grid ({grid})")
     entry = PlannerEntry(
         index=i, name=name, label=label.strip() if label else None, params=tuple(params),
         limits=_parse_limits(v.get("limits"), f"{where}.limits", top_limits),
@@ -429,7 +440,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
             raise ConfigError(f"{where}.scen: no such file {sp}")
         if family != "movingai":
             raise ConfigError(f"{where}.scen: scen files go with MovingAI maps "
-                              f"({{movingai: FILE}}), not {family!r}")
+                              f"({{movingai: FILE}}), not {_shown(family)}")
         if "lines" in v:  # the form now; the line numbers once the file is read
             _check_lines_form(v["lines"], f"{where}.lines")
     elif "start" in v or "goal" in v:
@@ -443,11 +454,13 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                                   f"{{random: N, min_distance_m: D}}, got {_short(dict(q))}")
             n = q["random"]
             if not _is_int(n) or n < 1:
-                raise ConfigError(f"{where}.queries.random: must be an integer >= 1, got {n!r}")
+                raise ConfigError(f"{where}.queries.random: must be an integer >= 1, got"
+                                  f" {_shown(n)}")
+            check_count(int(n), "MAX_RUNS", f"{where}.queries.random")
             d = q.get("min_distance_m", 0.0)
             if not _is_num(d) or float(d) < 0:
                 raise ConfigError(f"{where}.queries.min_distance_m: must be a number >= 0, "
-                                  f"got {d!r}")
+                                  f"got {_shown(d)}")
             random_q = {"count": int(n), "min_distance_m": float(d)}
         elif isinstance(q, list) and q:
             for j, item in enumerate(q):
@@ -508,7 +521,7 @@ def _entry_name(v: Mapping[str, Any], where: str, default: str) -> str:
     name = v.get("name", default)
     if not isinstance(name, str) or not name.strip() or "/" in name:
         raise ConfigError(f"{where}.name: must be a non-empty string without '/', "
-                          f"got {name!r}")
+                          f"got {_shown(name)}")
     return name.strip()
 
 
@@ -522,7 +535,7 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
         elif low.endswith((".yaml", ".yml")):
             m = {"ros": m}
         else:
-            raise ConfigError(f"{where}: {m!r} is not a map family (paper, random) nor a "
+            raise ConfigError(f"{where}: {_shown(m)} is not a map family (paper, random) nor a "
                               ".map / .yaml file; use a mapping such as {image: FILE, "
                               "resolution: 0.05}")
     if not isinstance(m, Mapping):
@@ -545,7 +558,7 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
         if "seed" in spec[family] and (not _is_int(spec[family]["seed"])
                                        or spec[family]["seed"] < 0):
             raise ConfigError(f"{where}.{family}.seed: must be an integer >= 0, "
-                              f"got {spec[family]['seed']!r}")
+                              f"got {_shown(spec[family]['seed'])}")
     elif family in FILE_FAMILIES:
         rel = spec[family]
         if not isinstance(rel, str) or not rel.strip():
@@ -577,6 +590,6 @@ def _check_queries(entry: MapEntry, grid: Any) -> None:
                     entry.family == "paper" and not entry.queries[1:]) \
                     else f"maps[{entry.index}].queries[{j}].{what}"
                 raise ConfigError(f"{w}: ({p[0]:g}, {p[1]:g}) lies outside map "
-                                  f"{entry.name!r} [{x0:g}, {x1:g}) x [{y0:g}, {y1:g})")
+                                  f"{_shown(entry.name)} [{x0:g}, {x1:g}) x [{y0:g}, {y1:g})")
 
 

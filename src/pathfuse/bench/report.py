@@ -36,6 +36,10 @@ Statistics (every row):
   experiment file named (the stored ``runs.R_length``: the reference
   planner, or the optimum of a MovingAI scen line); ``reference=`` picks a
   planner or planner configuration of the study instead.
+* excess over the shortest path = (L - L_shortest) / L_shortest, when the
+  study ran the ``shortest`` planner: each solved run paired with
+  ``shortest``'s solved run on the same problem and seed (``excess_pairs``;
+  :func:`~pathfuse.bench.study.excess_values`).
 
 A swept parameter is one that takes more than one value among the
 configurations of a planner (per run kind), read from the configurations'
@@ -162,10 +166,10 @@ def _r_cell(row: Mapping[str, Any]) -> str:
 def _table(rows: Sequence[Mapping[str, Any]], first: Sequence[tuple[str, str]],
            dynamic: bool) -> list[list[list[str]]]:
     """Three tables of at most nine columns (a window's width): outcomes, lengths and
-    times, R_length.
+    times, R_length (and the excess over the shortest path, when the study has one).
 
     Lengths in m with 3 decimals, times with 3 significant digits (mean, interval and
-    median of a row alike), rates in % with 1 decimal, R_length with 2.
+    median of a row alike), rates in % with 1 decimal, R_length and the excess with 2.
     """
     key = [h for h, _ in first]
     out_head = key + ["runs", "success [95% CI]", "errors", "not solved by status",
@@ -174,6 +178,9 @@ def _table(rows: Sequence[Mapping[str, Any]], first: Sequence[tuple[str, str]],
                       "median"] + (["time to goal (s) mean [95% CI]", "median"] if dynamic
                                    else [])
     r_head = key + ["R_length mean [95% CI]", "median", "shorter / pairs"]
+    excess = any(r.get("excess_pairs") for r in rows)
+    if excess:
+        r_head += ["excess over the shortest path mean [95% CI]", "median", "pairs"]
     outcomes, numbers, ratios = [out_head], [num_head], [r_head]
     for r in rows:
         k = [str(r[c]) for _, c in first]
@@ -186,9 +193,15 @@ def _table(rows: Sequence[Mapping[str, Any]], first: Sequence[tuple[str, str]],
                             *_num_ci(r, "time", "_s", 1e3)]
                        + (list(_num_ci(r, "time_to_goal", "_s")) if dynamic else []))
         pairs = r["r_length_pairs"]
-        ratios.append(k + [_r_cell(r),
-                           f"{100 * r['r_length_median']:+.2f}%" if pairs else "n/a",
-                           f"{r['r_length_shorter']}/{pairs}" if pairs else "n/a"])
+        line = k + [_r_cell(r), f"{100 * r['r_length_median']:+.2f}%" if pairs else "n/a",
+                    f"{r['r_length_shorter']}/{pairs}" if pairs else "n/a"]
+        if excess:
+            n = r.get("excess_pairs", 0)
+            line += ["n/a" if not n else
+                     f"{100 * r['excess_mean']:+.2f}% [{100 * r['excess_ci_low']:+.2f}, "
+                     f"{100 * r['excess_ci_high']:+.2f}]",
+                     "n/a" if not n else f"{100 * r['excess_median']:+.2f}%", str(n)]
+        ratios.append(line)
     return [outcomes, numbers, ratios]
 
 
@@ -226,7 +239,10 @@ _NOTES = (
     "R_length = (L - L_ref) / L_ref over the runs where the run and its "
     "reference both solved the same problem (problem_key + seed); pairs = how many; "
     "shorter = pairs where the configuration's path is shorter than the reference's. "
-    "R_length < 0: shorter than the reference."
+    "R_length < 0: shorter than the reference. When the study ran the planner shortest (the "
+    "true shortest path among the occupied squares), the excess over the shortest path = "
+    "(L - L_shortest) / L_shortest pairs every solved run with shortest's on the same "
+    "problem and seed."
 )
 
 

@@ -28,7 +28,9 @@ from pathfuse.bench.keys import (
     file_digest,
     run_key,
 )
+from pathfuse.limits import check_count
 from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.validate import short as _shown
 
 
 @dataclass(frozen=True)
@@ -215,6 +217,11 @@ class Experiment:
         plain_defaults = {(p.index, k): _plain(d) for p in self.planners
                           for k, d in p.defaults_by_kind.items()}
         plain_limits = {p.index: _plain(p.limits.as_dict()) for p in self.planners}
+        total = 0
+        for entry in self.maps:  # count first: refuse a run list above MAX_RUNS unbuilt
+            per_query = sum(len(c) for p, c in combos if entry.kind in p.kinds)
+            total += len(entry.seeds) * len(self._queries(entry, entry.seeds[0])) * per_query
+        check_count(total, "MAX_RUNS", f"{self.path}: the experiment's runs")
         for entry in self.maps:
             applicable = [(p, c) for p, c in combos if entry.kind in p.kinds]
             reference = _plain(self.reference if entry.kind == "static" else None)
@@ -373,7 +380,7 @@ def _select_lines(probs: list[Any], sel: Any, where: str) -> list[Any]:
         out = []
         for i, ln in enumerate(sel):
             if not _is_int(ln) or ln not in by_line:
-                raise ConfigError(f"{where}[{i}]: no problem on line {ln!r} of the scen file "
+                raise ConfigError(f"{where}[{i}]: no problem on line {_shown(ln)} of the scen file "
                                   f"(lines {probs[0].line}..{probs[-1].line})" if probs else
                                   f"{where}[{i}]: the scen file holds no problem")
             out.append(by_line[int(ln)])
@@ -385,9 +392,9 @@ def _select_lines(probs: list[Any], sel: Any, where: str) -> list[Any]:
         if "sample" in keys and keys <= {"sample", "seed"}:
             n, s = sel["sample"], sel.get("seed", 0)
             if not _is_int(n) or n < 1:
-                raise ConfigError(f"{where}.sample: must be an integer >= 1, got {n!r}")
+                raise ConfigError(f"{where}.sample: must be an integer >= 1, got {_shown(n)}")
             if not _is_int(s) or s < 0:
-                raise ConfigError(f"{where}.seed: must be an integer >= 0, got {s!r}")
+                raise ConfigError(f"{where}.seed: must be an integer >= 0, got {_shown(s)}")
             if n >= len(probs):
                 return probs
             idx = np.sort(np.random.default_rng(int(s)).choice(len(probs), int(n),
@@ -396,7 +403,7 @@ def _select_lines(probs: list[Any], sel: Any, where: str) -> list[Any]:
         if keys == {"every"}:
             k = sel["every"]
             if not _is_int(k) or k < 1:
-                raise ConfigError(f"{where}.every: must be an integer >= 1, got {k!r}")
+                raise ConfigError(f"{where}.every: must be an integer >= 1, got {_shown(k)}")
             return probs[:: int(k)]
     raise ConfigError(f"{where}: expected N, a list of line numbers, {{limit: N}}, "
                       f"{{sample: N, seed: S}} or {{every: K}}, got {_short(sel)}")

@@ -56,7 +56,9 @@ runs (pathfuse columns)
     ``info`` (JSON of the planner's scalar extras); ``timing`` (JSON of
     the extras that are clock readings: keys with time, rate, ``_s``);
     ``path`` (BLOB,
-    little-endian float64 (N, 2), only with ``store_paths``);
+    little-endian float64 (N, 2), only with ``store_paths``); ``headings``
+    (BLOB, little-endian float64 (N,), the heading at each path point of a
+    dynamic run whose robot has one, only with ``store_paths``);
     ``pathfuse_version``; ``host``; ``worker``; ``started_at``;
     ``finished_at``; ``wall_time`` (s, whole run incl. metrics).
 progress
@@ -172,6 +174,8 @@ RUN_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("info", "TEXT", "JSON of the planner's scalar extras (clock readings excluded)"),
     ("timing", "TEXT", "JSON of the planner's clock readings (keys naming a time/rate)"),
     ("path", "BLOB", "little-endian float64 (N, 2) path, with store_paths"),
+    ("headings", "BLOB", "little-endian float64 (N,) heading in rad at each path point (dynamic "
+     "runs whose robot has a heading), with store_paths"),
     ("pathfuse_version", "TEXT", "pathfuse version of the worker"),
     ("host", "TEXT", "host name of the worker"),
     ("worker", "TEXT", "worker process id or Dask worker address"),

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from pathfuse.bench.summary import group_stats
+from pathfuse.bench.summary import group_stats, value_stats
 from pathfuse.result import ConfigError
 
 _RUN_FIELDS = ("id", "experimentid", "plannerid", "kind", "planner", "seed", "problem_key",
@@ -290,6 +290,28 @@ def r_length_values(study: Study, reference: str | None = None) -> dict[int, flo
     return out
 
 
+def excess_values(study: Study) -> dict[int, float]:
+    """``{run id: (L - L_shortest) / L_shortest}``: each solved run paired with the solved run
+    of the ``shortest`` planner on the same ``problem_key`` and ``seed`` (empty when the
+    study has no ``shortest`` run)."""
+    low: dict[tuple[str, str, int], float] = {}
+    for r in study.runs:
+        if study.configs[r["plannerid"]].planner == "shortest" and r["solved"] \
+                and r["solution_length"] is not None and r["solution_length"] > 0:
+            low[(r["kind"], r["problem_key"], r["seed"])] = float(r["solution_length"])
+    out: dict[int, float] = {}
+    if not low:
+        return out
+    for r in study.runs:
+        if not r["solved"] or r["solution_length"] is None \
+                or study.configs[r["plannerid"]].planner == "shortest":
+            continue
+        ls = low.get((r["kind"], r["problem_key"], r["seed"]))
+        if ls is not None:
+            out[r["id"]] = (float(r["solution_length"]) - ls) / ls
+    return out
+
+
 def _reference_label(study: Study, reference: str | None) -> str:
     if reference is not None:
         ids = resolve_reference(study, reference)
@@ -339,6 +361,7 @@ def summary_rows(study: Study, reference: str | None = None,
     """
     if rl is None:
         rl = r_length_values(study, reference)
+    ex = excess_values(study)
     swept = sorted({p for ps in swept_parameters(study).values() for p in ps})
     rows = []
     for scope, kind, runs, pooled in _scopes(study):
@@ -352,6 +375,12 @@ def summary_rows(study: Study, reference: str | None = None,
             for p in swept:
                 row[f"param.{p}"] = _param_text(c.params[p]) if p in c.params else ""
             row.update(_group_stats(by[cid], rl))
+            vals = [ex[r["id"]] for r in by[cid] if r["id"] in ex]
+            st = value_stats(vals, "excess")
+            row.update({"excess_pairs": len(vals), "excess_mean": st["excess_mean"],
+                        "excess_ci_low": st["excess_ci_low"],
+                        "excess_ci_high": st["excess_ci_high"],
+                        "excess_median": st["excess_median"]})
             rows.append(row)
     return rows
 

@@ -11,7 +11,8 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from pathfuse.result import PathfuseError
+from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.validate import short as _shown
 
 EXIT_FAIL = 1
 EXIT_USAGE = 2
@@ -29,15 +30,17 @@ MAIN_EPILOG = _fmt("""
 examples:
   pathfuse paper --seeds 100 --out paper-out
   pathfuse plan --map paper --seed 3 --plot plan.png
-  pathfuse plan --map den312d.map --start 10.5,70.5 --goal 60.5,8.5 --json
-  pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 500
+  pathfuse plan --map tests/data/movingai/den312d.map --start 10.5,70.5 --goal 60.5,8.5 --json
+  pathfuse scen tests/data/movingai/maze-32-32-2.map tests/data/movingai/maze-32-32-2-random-1.scen
   pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
   pathfuse dynamic --seeds 50 --moving 0 2 4 8 --out dynamic-out
+  pathfuse barn ../shared/data/barn --worlds 0-24 --out barn-out
   pathfuse bench experiments/fusion-sweep-r1-r2-step.yaml --db sweep.db --seeds 20
   pathfuse report sweep.db --out sweep-report
   pathfuse planners
 
-Run 'pathfuse COMMAND --help' for the options of a command.
+The paths are those of a clone of the repository.  Run 'pathfuse COMMAND --help' for the
+options of a command.
 """)
 
 
@@ -50,25 +53,28 @@ def parse_point(text: str, what: str) -> tuple[float, float]:
             raise ValueError
         x, y = float(parts[0]), float(parts[1])
     except ValueError:
-        raise CliError(f"{what}: expected X,Y (two numbers in metres), got {text!r}") from None
+        raise CliError(f"{what}: expected X,Y (two numbers in metres), got"
+                       f" {_shown(text)}") from None
     if not (math.isfinite(x) and math.isfinite(y)):
-        raise CliError(f"{what}: coordinates must be finite, got {text!r}")
+        raise CliError(f"{what}: coordinates must be finite, got {_shown(text)}")
     return x, y
 
 
 def parse_params(items: Sequence[str] | None) -> dict[str, Any]:
     """``["r1=1.5", "ahead=paper-x"]`` -> {"r1": 1.5, "ahead": "paper-x"} (YAML scalars)."""
-    import yaml
+    from pathfuse.safeyaml import load_yaml
 
     out: dict[str, Any] = {}
     for item in items or []:
         key, sep, val = item.partition("=")
         if not sep or not key.strip():
-            raise CliError(f"--param: expected KEY=VALUE, got {item!r}")
+            raise CliError(f"--param: expected KEY=VALUE, got {_shown(item)}")
         try:
-            out[key.strip()] = yaml.safe_load(val)
-        except yaml.YAMLError:
-            raise CliError(f"--param {key}: cannot read value {val!r}") from None
+            out[key.strip()] = load_yaml(val, f"--param {key.strip()}", CliError)
+        except CliError:
+            raise
+        except ConfigError as exc:  # a limit
+            raise CliError(str(exc)) from None
     return out
 
 
@@ -81,7 +87,7 @@ def _int_at_least(minimum: int, what: str):
         except ValueError:
             v = minimum - 1
         if v < minimum:
-            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
+            raise argparse.ArgumentTypeError(f"expected {what}, got {_shown(text)}")
         return v
 
     return parse
@@ -95,23 +101,23 @@ def _float(text: str) -> float:
     try:
         v = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected a number, got {_shown(text)}") from None
     if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {_shown(text)}")
     return v
 
 
 def _nonneg_float(text: str) -> float:
     v = _float(text)
     if v < 0:
-        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {_shown(text)}")
     return v
 
 
 def _positive_float(text: str) -> float:
     v = _float(text)
     if v <= 0:
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {_shown(text)}")
     return v
 
 
@@ -130,7 +136,7 @@ def parse_speed(text: str) -> tuple[float, float]:
             raise ValueError
     except ValueError:
         raise CliError(f"--speed: expected MIN,MAX in m/s with 0 < MIN <= MAX, "
-                       f"got {text!r}") from None
+                       f"got {_shown(text)}") from None
     return lo, hi
 
 
@@ -141,7 +147,7 @@ def parse_planner_list(text: str | None) -> tuple[str, ...]:
     names = tuple(n.strip() for n in str(text).split(",") if n.strip())
     if not names:
         raise CliError(f"--planners: expected comma-separated online planner names, "
-                       f"got {text!r}")
+                       f"got {_shown(text)}")
     return names
 
 
@@ -151,7 +157,7 @@ def parse_planner_params(items: Sequence[str] | None) -> dict[str, dict[str, Any
     for key, val in parse_params(items).items():
         name, dot, param = key.partition(".")
         if not dot or not name or not param:
-            raise CliError(f"--param: expected PLANNER.KEY=VALUE, got {key!r}")
+            raise CliError(f"--param: expected PLANNER.KEY=VALUE, got {_shown(key)}")
         out.setdefault(name, {})[param] = val
     return out
 
@@ -163,9 +169,26 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
 
 
+def output_file(text: str, option: str, suffix: str) -> str:
+    """An output file name checked before any work: not a folder, in a folder that exists;
+    ``suffix`` is added when the name has none (``--plot out`` writes ``out.png``)."""
+    from pathlib import Path
+
+    p = Path(text).expanduser()
+    if p.is_dir():
+        raise CliError(f"{option}: {text} is a folder; give a file name such as "
+                       f"{p / ('plan' + suffix)}")
+    if not p.suffix:
+        p = p.with_name(p.name + suffix)
+    if not p.parent.is_dir():
+        raise CliError(f"{option}: the folder {p.parent} does not exist")
+    return str(p)
+
+
 def _load_map(args: argparse.Namespace):
     from pathfuse.io import load_map
 
-    return load_map(args.map, resolution=args.resolution, seed=args.seed)
+    return load_map(args.map, resolution=args.resolution, seed=args.seed,
+                    unknown=getattr(args, "unknown", "occupied"))
 
 

@@ -6,6 +6,7 @@ import argparse
 import json
 import math
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -13,12 +14,15 @@ from pathfuse.cli.args import (
     EXIT_FAIL,
     CliError,
     _load_map,
+    output_file,
     parse_params,
     parse_planner_list,
     parse_planner_params,
     parse_point,
     parse_speed,
 )
+from pathfuse.result import PathfuseError
+from pathfuse.validate import short as _shown
 
 
 # --------------------------------------------------------------------------- commands
@@ -34,6 +38,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
     start = parse_point(args.start, "--start") if args.start else PAPER_START
     goal = parse_point(args.goal, "--goal") if args.goal else PAPER_GOAL
     params = parse_params(args.param)
+    if args.plot:
+        args.plot = output_file(args.plot, "--plot", ".png")
     budget = pathfuse.Budget(time_limit_s=args.time_limit) if args.time_limit else None
     _warm_with_notice(args.planner)
     result = pathfuse.plan(grid, start, goal, planner=args.planner, budget=budget,
@@ -113,15 +119,16 @@ def _progress(total: int, label: str, unit: str, args: argparse.Namespace) -> An
                        enabled=not getattr(args, "quiet", False))
 
 
-def _warm_with_notice(planner: str, world: bool = False) -> None:
-    """Compile the planner's kernels (and the world's) now, saying so first when numba's
-    cache is cold."""
+def _warm_with_notice(planner: str | Sequence[str], world: bool = False) -> None:
+    """Compile the kernels of the planner(s) (and the world's) now, saying so first, in one
+    line, when numba's cache is cold."""
     from pathfuse.bench.warmup import warm_kernels
 
     def notice(text: str) -> None:
         print(f"pathfuse: {text}", file=sys.stderr, flush=True)
 
-    warm_kernels([planner], metrics=False, world=world, notify=notice)
+    names = [planner] if isinstance(planner, str) else list(planner)
+    warm_kernels(names, metrics=False, world=world, notify=notice)
 
 
 def planner_table() -> dict[str, Any]:
@@ -159,7 +166,8 @@ def cmd_planners(args: argparse.Namespace) -> int:
     for name, d in table.items():
         runs = " and ".join(k for k in ("offline", "online") if d[k])
         also = f"; also called {', '.join(d['aliases'])}" if d["aliases"] else ""
-        parts = ["global planner: A*" if d["global_planner"] == "astar" else "",
+        gp = d["global_planner"]
+        parts = [f"global planner: {'A*' if gp == 'astar' else gp}" if gp else "",
                  f"controller: {d['controller']}" if d["controller"] else "a plug-in function"]
         print(f"{name}  ({'; '.join(x for x in parts if x)}; runs {runs}{also})")
         print(f"  {d['description']}")
@@ -169,7 +177,7 @@ def cmd_planners(args: argparse.Namespace) -> int:
                 print(f"    {p['name']} = {p['default']!r}{unit}  ({p['accepts']}): {p['help']}")
         else:
             shown = ", ".join(f"{p['name']}={p['default']!r}" for p in d["params"])
-            print(f"  parameters: {shown}")
+            print(f"  parameters: {shown or 'none'}")
     if not args.params:
         print("\n'pathfuse planners --params' explains every parameter (unit, range, meaning).")
     return 0
@@ -185,12 +193,20 @@ def _study_db(out: str) -> Path:
 
 
 def cmd_paper(args: argparse.Namespace) -> int:
-    from pathfuse.studies.paper import PaperConfig, run_paper, summary_rows, write_paper_outputs
+    from pathfuse.studies.paper import (
+        REFERENCES,
+        PaperConfig,
+        run_paper,
+        summary_rows,
+        write_paper_outputs,
+    )
 
+    variants = ("pathfuse", "paper") if args.variant == "both" else (args.variant,)
     cfg = PaperConfig(
         n_seeds=args.seeds, first_seed=args.first_seed,
         figure_seed=args.seed if args.seed is not None else args.first_seed,
-        step_m=args.step,
+        step_m=args.step, variants=variants, corner_cutting=args.corner_cutting,
+        references=() if args.no_references else REFERENCES,
     )
     if not cfg.first_seed <= cfg.figure_seed < cfg.first_seed + cfg.n_seeds:
         raise CliError(
@@ -207,11 +223,13 @@ def cmd_paper(args: argparse.Namespace) -> int:
           + (f", {sm.compile_s:.1f} s of it compiling kernels" if sm.compile_s >= 1.0 else "")
           + ")"
           + (f", {sm.skipped} already in {sm.db_path}" if sm.skipped else ""))
-    print(f"{'planner':<8} {'success':>12} {'length mean':>12} {'R_length':>10} {'time mean':>11}")
+    print(f"{'variant':<9} {'planner':<13} {'success':>12} {'length mean':>12} {'R_length':>10} "
+          f"{'excess':>9} {'time mean':>11}")
     for r in summary_rows(run):
-        rl = "-" if r["planner"] == "fusion" else f"{100 * r['r_length_mean']:+.2f}%"
-        print(f"{r['planner']:<8} {r['successes']:>5}/{r['maps']:<6} "
-              f"{r['length_mean_m']:>11.4f}m {rl:>10} {1e3 * r['time_mean_s']:>9.3f}ms")
+        rl = "-" if r["is_fusion"] else f"{100 * r['r_length_mean']:+.2f}%"
+        ex = "-" if not r["excess_pairs"] else f"{100 * r['excess_mean']:+.2f}%"
+        print(f"{r['variant']:<9} {r['planner']:<13} {r['successes']:>5}/{r['maps']:<6} "
+              f"{r['length_mean_m']:>11.4f}m {rl:>10} {ex:>9} {1e3 * r['time_mean_s']:>9.3f}ms")
     for path in files.values():
         print(f"wrote {path}")
     return 0
@@ -338,7 +356,26 @@ def parse_seeds(text: str) -> int | str | list[int]:
         return n
     except ValueError:
         raise CliError(f"--seeds: expected a count N >= 1, a range A:B with 0 <= A < B, "
-                       f"or a list A,B,C of seeds >= 0, got {text!r}") from None
+                       f"or a list A,B,C of seeds >= 0, got {_shown(text)}") from None
+
+
+def _announce_imports(path: str) -> None:
+    """Name on stderr, before they run, the modules an experiment file's ``imports:`` loads
+    (an experiment file with imports is code).  A file that cannot be read is left to the
+    experiment loader, which words the error."""
+    from pathfuse.safeyaml import read_yaml
+
+    try:
+        doc = read_yaml(path, "experiment")
+    except PathfuseError:
+        return
+    imports = doc.get("imports") if isinstance(doc, dict) else None
+    if isinstance(imports, str):
+        imports = [imports]
+    if isinstance(imports, list) and imports:
+        names = ", ".join(str(i) for i in imports)
+        print(f"pathfuse bench: importing {names} (the experiment file's 'imports:' runs "
+              "this code)", file=sys.stderr, flush=True)
 
 
 def _quiet_dask_logs() -> None:
@@ -358,6 +395,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from pathfuse.bench import ClusterLost, SweepInterrupted, run_bench
 
     seeds = None if args.seeds is None else parse_seeds(args.seeds)
+    _announce_imports(args.experiment)
     if args.scheduler:  # a lost cluster is one line of ours, not Dask's tracebacks
         _quiet_dask_logs()
     try:
@@ -408,3 +446,44 @@ def cmd_report(args: argparse.Namespace) -> int:
     return 0
 
 
+
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    """``pathfuse serve``: the planning playground in the browser (uvicorn + Starlette)."""
+    try:
+        import uvicorn
+
+        from pathfuse.web.app import create_app, default_map_folders
+        from pathfuse.web.maps import Limits
+    except ImportError as exc:
+        raise CliError(f"the web app needs its extra: pip install \"pathfuse[web]\" "
+                       f"({exc.name} is missing)") from None
+    folders = default_map_folders()
+    for folder in args.maps or []:
+        p = Path(folder).expanduser()
+        if not p.is_dir():
+            raise CliError(f"--maps: {p} is not a folder")
+        folders.append((p.resolve().name, p))
+    limits = Limits(max_cells=args.max_cells, max_upload_bytes=args.max_upload_mb * 1024 * 1024,
+                    time_budget_s=args.budget)
+    app = create_app(map_folders=folders, limits=limits, workers=args.workers,
+                     warm=not args.no_warm)
+    host = args.host
+    url = f"http://{'[' + host + ']' if ':' in host else host}:{args.port}/"
+    if host not in ("127.0.0.1", "localhost", "::1"):
+        print(f"pathfuse serve: listening on {host}: anyone who can reach this machine can use "
+              "the app", file=sys.stderr)
+    print(f"pathfuse serve: {url}  (Ctrl-C stops it)", file=sys.stderr, flush=True)
+    if args.open:
+        import threading
+        import webbrowser
+
+        threading.Timer(1.0, lambda: webbrowser.open(url)).start()
+    config = uvicorn.Config(app, host=host, port=args.port, log_level=args.log_level,
+                            timeout_keep_alive=5, limit_concurrency=64)
+    server = uvicorn.Server(config)
+    try:
+        server.run()
+    except OSError as exc:
+        raise CliError(f"cannot listen on {host}:{args.port}: {exc.strerror or exc}") from None
+    return 0

@@ -17,6 +17,7 @@ from pathfuse.cli.args import (
     _positive_float,
     _positive_int,
 )
+from pathfuse.cli.barn import add_barn_parser
 from pathfuse.cli.commands import (
     cmd_bench,
     cmd_dynamic,
@@ -25,6 +26,7 @@ from pathfuse.cli.commands import (
     cmd_planners,
     cmd_report,
     cmd_scen,
+    cmd_serve,
     cmd_simulate,
 )
 from pathfuse.result import PathfuseError
@@ -52,8 +54,10 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_fmt("""
 examples:
   pathfuse plan --map paper --seed 3 --planner astar --plot plan.png
-  pathfuse plan --map maps/office.yaml --start 1.0,2.5 --goal 8.2,4.0 --robot-radius 0.2
-  pathfuse plan --map room.png --resolution 0.05 --start 1,1 --goal 5,4 --json
+  pathfuse plan --map tests/data/ros/nav2_tb3_sandbox/tb3_sandbox.yaml --start -1.0,-0.5 \
+                --goal 1.5,0.5 --robot-radius 0.1
+  pathfuse plan --map tests/data/ros/nav2_tb3_sandbox/tb3_sandbox.pgm --resolution 0.05 \
+                --start 9.0,9.5 --goal 11.5,10.5 --json
   pathfuse plan --map paper --planner astar --param heuristic=octile
 
 --map accepts: 'paper' (the paper's random 15 m map, --seed N), a MovingAI .map,
@@ -69,6 +73,8 @@ a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolu
                    help="planner parameter, repeatable (e.g. --param heuristic=octile)")
     p.add_argument("--resolution", type=_float, help="metres per cell for image/.npy maps")
     p.add_argument("--seed", type=int, default=0, help="seed of --map paper (default 0)")
+    p.add_argument("--unknown", choices=["occupied", "free"], default="occupied",
+                   help="what the unknown cells of a ROS map are (default occupied)")
     p.add_argument("--robot-radius", type=_nonneg_float, default=0.0,
                    help="radius of a disc robot in metres: the path keeps this clearance "
                    "from obstacles and the map's edge (default 0)")
@@ -84,9 +90,10 @@ a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolu
         "diagonals, no corner cutting) and count how many match the file's optimal length.  "
         "Exit status 1 on any mismatch.",
         epilog=_fmt("""
-example:
-  pathfuse scen den312d.map den312d.map.scen
-  pathfuse scen maze512-4-6.map maze512-4-6.map.scen --limit 1000 --heuristic octile
+examples:
+  pathfuse scen tests/data/movingai/den312d.map tests/data/movingai/den312d.map.scen
+  pathfuse scen tests/data/movingai/maze-32-32-2.map \
+                tests/data/movingai/maze-32-32-2-random-1.scen --limit 100 --heuristic euclidean
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -107,11 +114,17 @@ example:
         description="Run the paper's setup (15 m map, start (1, 1), goal (11, 11), 50 random "
         "obstacles, K_att 40, K_rep 5, rho_0 2 m) with all five planners on N seeded maps and "
         "write Tables I and II (one map and statistics over all maps) as Markdown and CSV, "
-        "Fig. 3 and a box plot of R_length into --out.",
+        "Fig. 3 and a box plot of R_length into --out. Every table also holds A* with "
+        "line-of-sight smoothing, Theta* and the true shortest path, and each planner's excess "
+        "over the shortest path. --variant paper runs apf, ref6, ref7 and fusion as printed "
+        "(eq. 8, no escape, the full step along the force: a step that touches an obstacle is "
+        "a COLLISION; no stall test); --variant pathfuse with pathfuse's defaults; both (the "
+        "default) gives one table per variant.",
         epilog=_fmt("""
 examples:
   pathfuse paper --out paper-out
   pathfuse paper --seeds 1000 --seed 7 --out paper-1000
+  pathfuse paper --seeds 1000 --variant paper --corner-cutting --out paper-as-printed
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -122,6 +135,7 @@ examples:
                     help="the map of the one-map tables and Fig. 3 (default: the first seed)")
     pp.add_argument("--step", type=_float, default=0.1,
                     help="step length in metres of every stepping planner (default 0.1)")
+    _add_paper_variant_options(pp)
     pp.add_argument("--workers", type=_positive_int, default=None,
                     help="worker processes (default: every usable CPU; 1 = in this process)")
     pp.add_argument("--out", default="paper-out",
@@ -214,6 +228,8 @@ examples:
                     "few plain lines otherwise)")
     dy.set_defaults(func=cmd_dynamic)
 
+    add_barn_parser(sub)
+
     b = sub.add_parser(
         "bench",
         help="run (or resume) a benchmark sweep into a study database",
@@ -265,9 +281,9 @@ See experiments/*.yaml for the file format (maps, seeds, planners, swept paramet
         "report",
         help="tables and figures of a study database (Markdown, CSV, PNG, HTML)",
         description="Summarise a study database of 'pathfuse bench' per map entry and "
-        "planner configuration (and every entry pooled): runs, success rate with a 95%% "
+        "planner configuration (and every entry pooled): runs, success rate with a 95% "
         "Wilson interval, errors (never dropped), collision-free rate, path length and "
-        "planning time (mean with a 95%% t interval, median), R_length against a reference "
+        "planning time (mean with a 95% t interval, median), R_length against a reference "
         "(paired on the same problem and seed, with the number of pairs), time to goal and "
         "collisions for dynamic runs; box plots per configuration, and every swept "
         "parameter against success rate and length.  Writes report.html (self-contained), "
@@ -310,7 +326,48 @@ with one configuration; by default R_length is against the experiment's own refe
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=cmd_planners)
 
+    _add_serve(sub)
     return parser
+
+
+def _add_serve(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse serve``: the planning playground in the browser."""
+    w = sub.add_parser(
+        "serve", help="the planning playground in the browser (pip install \"pathfuse[web]\")",
+        description="Start a local web app: draw or load a map, drag start and goal, run "
+        "any registered planners side by side, look at the potential field, the A* closed "
+        "set and the c-space, and play moving-obstacle episodes.  Its JSON API is "
+        "documented in the README.  Binds to 127.0.0.1 unless --host says otherwise.",
+        epilog=_fmt("""
+examples:
+  pathfuse serve --open
+  pathfuse serve --port 8080 --maps ../shared/data/movingai
+  pathfuse serve --host 0.0.0.0 --port 8000     # reachable from other machines
+
+Needs the web extra: pip install "pathfuse[web]".
+"""),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    w.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    w.add_argument("--port", type=_nonneg_int, default=8000, help="port (default 8000)")
+    w.add_argument("--open", action="store_true", help="open the page in a web browser")
+    w.add_argument("--maps", action="append", metavar="DIR",
+                   help="a folder of maps and scenario files to offer, repeatable (default: "
+                   "examples/ and tests/data/ of the source tree, when present)")
+    w.add_argument("--budget", type=_positive_float, default=20.0,
+                   help="seconds one request may compute (default 20)")
+    w.add_argument("--max-cells", type=_positive_int, default=2048 * 2048,
+                   help="cells of any map (default 4194304 = 2048 x 2048)")
+    w.add_argument("--max-upload-mb", type=_positive_int, default=32,
+                   help="size of an upload in MiB (default 32)")
+    w.add_argument("--workers", type=_positive_int, default=2,
+                   help="requests computed at once, each in a thread (default 2)")
+    w.add_argument("--no-warm", action="store_true",
+                   help="do not compile the planners' kernels when the server starts")
+    w.add_argument("--log-level", default="warning",
+                   choices=["critical", "error", "warning", "info", "debug"],
+                   help="uvicorn's log level (default warning)")
+    w.set_defaults(func=cmd_serve)
 
 
 _POINT_OPTIONS = ("--start", "--goal")
@@ -334,6 +391,18 @@ def _join_negative_values(argv: Sequence[str]) -> list[str]:
     return out
 
 
+def _one_line_warnings(command: str) -> None:
+    """Warnings (a ROS map's yaw, ...) as one line ``pathfuse CMD: warning: ...`` on stderr,
+    without Python's file, line and source line."""
+    import warnings
+
+    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+        text = " ".join(str(message).split())
+        print(f"pathfuse {command}: warning: {text}", file=file or sys.stderr)
+
+    warnings.showwarning = show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pathfuse`` console script."""
     parser = build_parser()
@@ -342,6 +411,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_USAGE
+    _one_line_warnings(args.command)
     from pathfuse.bench.lifeline import terminate_like_ctrl_c
 
     terminate_like_ctrl_c()  # SIGTERM ends a command like Ctrl-C: one line, stored runs kept
@@ -350,13 +420,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     except PathfuseError as exc:
         print(f"pathfuse {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    except (MemoryError, RecursionError) as exc:  # a last guard: the limits should come first
+        what = "out of memory" if isinstance(exc, MemoryError) else "input nested too deeply"
+        print(f"pathfuse {args.command}: error: {what}", file=sys.stderr)
+        return EXIT_USAGE
     except BrokenPipeError:  # output piped into e.g. `head`, which closed early
         import os
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except OSError as exc:
-        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        where = f" {exc.filename}:" if getattr(exc, "filename", None) else ""
         print(f"pathfuse {args.command}: error:{where} {exc.strerror or exc}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt as exc:
@@ -373,4 +447,17 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
+
+
+def _add_paper_variant_options(pp: argparse.ArgumentParser) -> None:
+    """``pathfuse paper``'s variant, corner rule and references."""
+    pp.add_argument("--variant", choices=["both", "pathfuse", "paper"], default="both",
+                    help="the stepping planners with pathfuse's defaults, as printed in the "
+                    "paper, or both, one table each (default both)")
+    pp.add_argument("--corner-cutting", action="store_true",
+                    help="the A* reference cuts corners (the paper's 14.7279 m is a "
+                    "corner-cutting length); default: no corner cutting")
+    pp.add_argument("--no-references", action="store_true",
+                    help="leave out astar-smooth, thetastar and shortest (and the excess "
+                    "over the shortest path)")
 

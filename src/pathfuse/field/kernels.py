@@ -28,7 +28,18 @@ Codes: :data:`CODE_RUNNING` (``max_steps`` reached: call again),
 (within the goal tolerance: a straight move onto the goal was appended, not
 counted as a step), :data:`CODE_STALLED` (net move below the stall distance
 over the stall window), :data:`CODE_BLOCKED` (no collision-free move along
-the force).  :func:`code_status` maps them to :class:`~pathfuse.result.Status`.
+the force), :data:`CODE_COLLISION` (``safe_step`` off: the full step along the
+force touched an obstacle; the step is in the path).  :func:`code_status`
+maps them to :class:`~pathfuse.result.Status`.
+
+The paper's rules (both loops): with ``I_SAFE`` = 0 the robot takes the full
+step along the force, as the paper's Algorithm 2 does, instead of the safe
+step (:func:`~pathfuse.field.motion.safe_step`: slide along the wall or
+shorten the step); a step that would touch an obstacle (for a disc robot:
+come closer than its radius, the rule of :mod:`pathfuse.metrics`) is taken and
+ends the run with :data:`CODE_COLLISION`.  With ``I_STALL`` = 0 there is no
+stall test (the paper's loop ends only at the goal): the run ends at the goal,
+a block, a collision or the move cap.
 """
 
 from __future__ import annotations
@@ -39,7 +50,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.field.forces import att_force_xy
-from pathfuse.field.motion import HOW_BLOCKED, safe_step, straight_move
+from pathfuse.field.motion import HOW_BLOCKED, HOW_FULL, safe_step, straight_move
 from pathfuse.field.pathing import advance_progress, find_rejoin
 from pathfuse.field.repulsion import (
     disc_repulsion,
@@ -56,6 +67,7 @@ __all__ = [
     "CODE_STALLED",
     "CODE_BLOCKED",
     "CODE_GOAL_SNAP",
+    "CODE_COLLISION",
     "code_status",
     "field_loop",
     "fusion_loop",
@@ -68,6 +80,7 @@ CODE_GOAL = 1
 CODE_STALLED = 2
 CODE_BLOCKED = 3
 CODE_GOAL_SNAP = 4
+CODE_COLLISION = 5
 
 # --- float settings shared by both loops (slots 0..19)
 F_GX, F_GY, F_KATT, F_KREP, F_RHO0, F_STEP, F_TOL, F_CLEAR, F_STALLD, F_OX = range(10)
@@ -81,7 +94,8 @@ N_F = 23
 I_STALLN, I_VELAWARE = 0, 1
 I_IMPROVED, I_TOGOAL = 2, 3  # field_loop
 I_AHEAD, I_ESCAPE, I_ESC_PTS, I_DRIVE = 2, 3, 4, 5  # fusion_loop
-N_I = 6
+I_SAFE, I_STALL = 6, 7  # both: safe step (ours) or the paper's full step; stall test (ours)
+N_I = 8
 # --- state
 S_SUB = 0  # field_loop: current sub-goal index
 # fusion_loop: progress index, mode (0 Algorithm 2, 1 escape along path points,
@@ -98,6 +112,8 @@ def code_status(code: int, steps: int, max_steps: int) -> Status:
         return Status.SUCCESS
     if code == CODE_STALLED or code == CODE_BLOCKED:
         return Status.LOCAL_MINIMUM
+    if code == CODE_COLLISION:
+        return Status.COLLISION
     if steps >= max_steps:
         return Status.MAX_ITERATIONS
     return Status.TIMEOUT
@@ -130,6 +146,27 @@ def _discs(x, y, fx, fy, f, i, dpos, dvel, drad):
     return disc_repulsion(x, y, f[F_RVX], f[F_RVY], f[F_RADIUS], dpos, dvel, drad, f[F_KMOV],
                           f[F_RHOMOV], f[F_REACH], i[I_VELAWARE] == 1, f[F_AMAX], f[F_SWERVE],
                           ux, uy)
+
+
+@njit(cache=True, inline="always")
+def _step(x, y, fx, fy, step, occ, ox, oy, res, clear, safe, radius):
+    """One move: the safe step (``safe``), or the paper's full step along the force.
+
+    Returns ``(nx, ny, how)``; for the full step ``how`` is ``HOW_BLOCKED`` for a
+    zero force, ``HOW_FULL`` for a step touching nothing and ``-1`` for a step
+    that touches an obstacle (closer than ``radius``; for a point any contact).
+    """
+    if safe:
+        return safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
+    fn = math.hypot(fx, fy)
+    if not (fn > 0.0) or not math.isfinite(fn):
+        return x, y, HOW_BLOCKED
+    nx = x + step * fx / fn
+    ny = y + step * fy / fn
+    touch = radius if radius > 0.0 else 5e-324
+    if segment_is_clear(x, y, nx, ny, occ, ox, oy, res, touch):
+        return nx, ny, HOW_FULL
+    return nx, ny, -1
 
 
 @njit(cache=True, inline="always")
@@ -181,6 +218,9 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
     nexp = f[F_NEXP]
     scale = f[F_SCALE]
     stall_n = i[I_STALLN]
+    safe = i[I_SAFE] == 1
+    stall = i[I_STALL] == 1
+    radius = f[F_RADIUS]
     improved = i[I_IMPROVED] == 1
     to_goal = i[I_TOGOAL] == 1
     last = subs.shape[0] - 1
@@ -215,7 +255,8 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
         fx += rx
         fy += ry
         dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
-        nx, ny, how = safe_step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear)
+        nx, ny, how = _step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear, safe,
+                            radius)
         if how == HOW_BLOCKED:
             code = CODE_BLOCKED
             break
@@ -225,7 +266,10 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
         steps += 1
         x = nx
         y = ny
-        if n - 1 >= stall_n:
+        if how < 0:
+            code = CODE_COLLISION
+            break
+        if stall and n - 1 >= stall_n:
             p = n - 1 - stall_n
             if math.hypot(x - buf[p, 0], y - buf[p, 1]) < stall_d:
                 code = CODE_STALLED
@@ -236,7 +280,7 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
 
 def pack_field(goal, k_att, k_rep, rho0_m, step_m, tol_m, clear_m, stall_steps,
                stall_distance_m, ox, oy, res, subgoal_tol_m, improved, to_goal, rep_exponent,
-               rep_scale_m, discs):
+               rep_scale_m, discs, safe_step=True, stall_exit=True):
     """Float and int settings of :func:`field_loop`; ``discs`` is :func:`disc_settings`."""
     f = np.zeros(N_F)
     f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
@@ -248,6 +292,8 @@ def pack_field(goal, k_att, k_rep, rho0_m, step_m, tol_m, clear_m, stall_steps,
     i[I_STALLN] = stall_steps
     i[I_IMPROVED] = 1 if improved else 0
     i[I_TOGOAL] = 1 if to_goal else 0
+    i[I_SAFE] = 1 if safe_step else 0
+    i[I_STALL] = 1 if stall_exit else 0
     _put_discs(f, i, discs)
     return f, i
 
@@ -340,6 +386,9 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
     escape = i[I_ESCAPE]
     esc_pts = i[I_ESC_PTS]
     drive = i[I_DRIVE] == 1
+    safe = i[I_SAFE] == 1
+    stall = i[I_STALL] == 1
+    radius = f[F_RADIUS]
     m = pts.shape[0]
     k = state[S_K]
     mode = state[S_MODE]
@@ -378,7 +427,8 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
             fx, fy, _ = fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0,
                                      r1, r2, occ, ox, oy, res)
             dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
-            nx, ny, how = safe_step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear)
+            nx, ny, how = _step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear, safe,
+                                radius)
             if how == HOW_BLOCKED:
                 blocked = True
             else:
@@ -390,7 +440,10 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
                 idle = 0
                 x = nx
                 y = ny
-                if n - 1 - ref >= stall_n:
+                if how < 0:
+                    code = CODE_COLLISION
+                    break
+                if stall and n - 1 - ref >= stall_n:
                     p = n - 1 - stall_n
                     ex = x - buf[p, 0]
                     ey = y - buf[p, 1]
@@ -475,7 +528,7 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
 
 def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, stall_steps,
                 stall_distance_m, ox, oy, res, ahead, escape, escape_points, backoff_window_m,
-                drive, discs):
+                drive, discs, safe_step=True, stall_exit=True):
     """Float and int settings of :func:`fusion_loop` (``r2_m`` is the repulsion radius)."""
     f = np.zeros(N_F)
     f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
@@ -489,5 +542,7 @@ def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, 
     i[I_ESCAPE] = 1 if escape else 0
     i[I_ESC_PTS] = escape_points
     i[I_DRIVE] = 1 if drive else 0
+    i[I_SAFE] = 1 if safe_step else 0
+    i[I_STALL] = 1 if stall_exit else 0
     _put_discs(f, i, discs)
     return f, i

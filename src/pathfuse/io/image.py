@@ -43,7 +43,9 @@ from pathlib import Path
 import numpy as np
 
 from pathfuse.grid import GridMap
-from pathfuse.result import MapError, MapFormatError
+from pathfuse.limits import check_cells
+from pathfuse.result import MapError, MapFormatError, PathfuseError
+from pathfuse.validate import short as _shown
 
 __all__ = ["read_image", "read_npy", "load_pixels", "IMAGE_SUFFIXES"]
 
@@ -83,8 +85,12 @@ def load_pixels(
     img: Image.Image  # an ImageFile until converted below
     try:
         with Image.open(path) as im:
+            w, h = im.size  # from the header: check before decoding
+            check_cells(h, w, f"{context}{path}: image")
             im.load()
             img = im
+    except PathfuseError:
+        raise
     except UnidentifiedImageError:
         raise MapFormatError(f"{context}{path}: not a readable image (unknown or corrupt format)") \
             from None
@@ -123,7 +129,7 @@ def load_pixels(
         grey = arr / 65535.0 * 255.0
     else:
         raise MapFormatError(
-            f"{context}{path}: unsupported image mode {mode!r} "
+            f"{context}{path}: unsupported image mode {_shown(mode)} "
             "(use grey, grey+alpha, palette, RGB or RGBA)"
         )
     if grey.ndim != 2 or grey.size == 0:
@@ -135,13 +141,13 @@ def _resolution(value: object, path: Path) -> float:
     if value is None:
         raise MapError(f"{path}: a resolution (metres per cell) is required for this map file")
     if isinstance(value, bool):
-        raise MapError(f"{path}: resolution must be a number, got {value!r}")
+        raise MapError(f"{path}: resolution must be a number, got {_shown(value)}")
     try:
         res = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
-        raise MapError(f"{path}: resolution must be a number, got {value!r}") from None
+        raise MapError(f"{path}: resolution must be a number, got {_shown(value)}") from None
     if not math.isfinite(res) or res <= 0:
-        raise MapError(f"{path}: resolution must be a finite number > 0, got {value!r}")
+        raise MapError(f"{path}: resolution must be a finite number > 0, got {_shown(value)}")
     return res
 
 
@@ -150,9 +156,9 @@ def _origin(value: object, path: Path) -> tuple[float, float]:
         # any iterable of two numbers; a TypeError is reported below
         ox, oy = (float(v) for v in value)  # type: ignore[attr-defined]
     except (TypeError, ValueError):
-        raise MapError(f"{path}: origin must be two numbers (x, y), got {value!r}") from None
+        raise MapError(f"{path}: origin must be two numbers (x, y), got {_shown(value)}") from None
     if not (math.isfinite(ox) and math.isfinite(oy)):
-        raise MapError(f"{path}: origin must be finite, got {value!r}")
+        raise MapError(f"{path}: origin must be finite, got {_shown(value)}")
     return ox, oy
 
 
@@ -202,10 +208,10 @@ def read_image(
     try:
         thr = float(threshold)
     except (TypeError, ValueError):
-        raise MapError(f"{path}: threshold must be a number in [0, 1], got {threshold!r}") \
+        raise MapError(f"{path}: threshold must be a number in [0, 1], got {_shown(threshold)}") \
             from None
     if not (0.0 <= thr <= 1.0):
-        raise MapError(f"{path}: threshold must be in [0, 1], got {threshold!r}")
+        raise MapError(f"{path}: threshold must be in [0, 1], got {_shown(threshold)}")
     grey, _alpha = load_pixels(path)
     shade = grey / 255.0
     occ = shade if negate else 1.0 - shade
@@ -257,16 +263,26 @@ def read_npy(
     org = _origin(origin, path)
     _check_file(path, "array file")
     try:
-        arr = np.load(path, allow_pickle=False)
+        # the header first (a memory map reads no data), so a huge array is refused unread
+        head = np.load(path, allow_pickle=False, mmap_mode="r")
+        if isinstance(head, np.ndarray) and head.ndim == 2:
+            check_cells(head.shape[0], head.shape[1], f"{path}: array")
+        arr = np.array(head) if isinstance(head, np.memmap) else head
+        del head
+    except PathfuseError:
+        raise
     except ValueError as exc:
         msg = str(exc)
-        if "allow_pickle" in msg or "pickle" in msg.lower():
+        if "allow_pickle" in msg or "pickle" in msg.lower() or "Python objects" in msg:
             raise MapFormatError(
                 f"{path}: holds an object (pickled) array; save a bool or numeric array"
             ) from None
-        raise MapFormatError(f"{path}: not a valid .npy file ({msg})") from None
+        raise MapFormatError(f"{path}: not a valid .npy file ({_shown(msg, 120)})") from None
     except (OSError, EOFError) as exc:
         raise MapFormatError(f"{path}: cannot read .npy file ({exc})") from None
+    except Exception as exc:  # noqa: BLE001 - numpy's header parser raises what Python's does
+        raise MapFormatError(f"{path}: not a valid .npy file (a malformed header: "
+                             f"{type(exc).__name__})") from None
     if not isinstance(arr, np.ndarray):
         raise MapFormatError(f"{path}: holds {type(arr).__name__}, not a single array")
     if arr.ndim != 2:

@@ -37,6 +37,7 @@ import numpy as np
 from pathfuse.grid import GridMap
 from pathfuse.io.ros import load_yaml_mapping
 from pathfuse.result import ConfigError, MapError, MapFormatError
+from pathfuse.validate import short as _shown
 
 __all__ = ["read_rows_yaml", "ROWS_KEYS", "FREE_CHAR", "BLOCKED_CHARS"]
 
@@ -47,6 +48,11 @@ ROWS_KEYS = ("rows", "resolution", "origin", "name")
 
 
 def _parse_rows(where: str, rows: object) -> list[str]:
+    if isinstance(rows, str) and rows.strip() and "\n" not in rows.strip():
+        raise MapFormatError(
+            f"{where}: 'rows' must be a list of strings (or a multi-line '|' block), got the "
+            f"single string {_shown(rows)}; write rows: [{_shown(rows)}] for a one-row map"
+        )
     if isinstance(rows, str):
         lines = [ln.strip() for ln in rows.splitlines()]
         lines = [ln for ln in lines if ln]
@@ -56,12 +62,13 @@ def _parse_rows(where: str, rows: object) -> list[str]:
             if not isinstance(r, str):
                 raise MapFormatError(
                     f"{where}: 'rows' entry {i + 1} (from the top) must be a string of "
-                    f"'.', '#' and '@', got {r!r} (quote rows in YAML)"
+                    f"'.', '#' and '@', got {_shown(r)} (quote rows in YAML)"
                 )
             lines.append(r)
     else:
         raise MapFormatError(
-            f"{where}: 'rows' must be a list of strings or one multi-line string, got {rows!r}"
+            f"{where}: 'rows' must be a list of strings or one multi-line string, got"
+            f" {_shown(rows)}"
         )
     if not lines:
         raise MapFormatError(f"{where}: 'rows' holds no row")
@@ -78,7 +85,7 @@ def _parse_rows(where: str, rows: object) -> list[str]:
             if ch != FREE_CHAR and ch not in BLOCKED_CHARS:
                 raise MapFormatError(
                     f"{where}: row {i + 1} (from the top), column {j + 1}: invalid character "
-                    f"{ch!r} (use '.' for free, '#' or '@' for blocked)"
+                    f"{_shown(ch)} (use '.' for free, '#' or '@' for blocked)"
                 )
     return lines
 
@@ -123,37 +130,39 @@ def read_rows_yaml(
     for key in doc:
         if key not in ROWS_KEYS:
             raise MapFormatError(
-                f"{where}: unknown key {key!r} in a rows map (allowed: {', '.join(ROWS_KEYS)})"
+                f"{where}: unknown key"
+                f" {_shown(key)} in a rows map (allowed: {', '.join(ROWS_KEYS)})"
             )
     if "rows" not in doc:
         raise MapFormatError(f"{where}: missing key 'rows'")
     for key, arg in (("resolution", resolution), ("origin", origin), ("name", name)):
         if arg is not None and key in doc:
-            raise ConfigError(f"{where}: {key} is given both by the map ({doc[key]!r}) and "
-                              f"by the caller ({arg!r})")
+            raise ConfigError(f"{where}: {key} is given both by the map ({_shown(doc[key])}) and "
+                              f"by the caller ({_shown(arg)})")
     lines = _parse_rows(where, doc["rows"])
 
     res_v = doc.get("resolution", resolution if resolution is not None else 1.0)
     if isinstance(res_v, bool):
-        raise MapFormatError(f"{where}: key 'resolution' must be a number, got {res_v!r}")
+        raise MapFormatError(f"{where}: key 'resolution' must be a number, got {_shown(res_v)}")
     try:
         res = float(res_v)
     except (TypeError, ValueError):
-        raise MapFormatError(f"{where}: key 'resolution' must be a number, got {res_v!r}") \
+        raise MapFormatError(f"{where}: key 'resolution' must be a number, got {_shown(res_v)}") \
             from None
     if not math.isfinite(res) or res <= 0:
         raise MapFormatError(f"{where}: key 'resolution' must be a finite number > 0, "
-                             f"got {res_v!r}")
+                             f"got {_shown(res_v)}")
     org_v = doc.get("origin", origin if origin is not None else (0.0, 0.0))
     try:
         if isinstance(org_v, (str, bytes)) or len(org_v) != 2:
             raise TypeError
         ox, oy = (float(v) for v in org_v)
     except (TypeError, ValueError):
-        raise MapFormatError(f"{where}: key 'origin' must be [x, y] in metres, got {org_v!r}") \
+        raise MapFormatError(f"{where}: key 'origin' must be [x, y] in metres, got"
+                             f" {_shown(org_v)}") \
             from None
     if not (math.isfinite(ox) and math.isfinite(oy)):
-        raise MapFormatError(f"{where}: key 'origin' must be finite, got {org_v!r}")
+        raise MapFormatError(f"{where}: key 'origin' must be finite, got {_shown(org_v)}")
     label = doc.get("name", name if name is not None else default_name)
     arr = np.array([[ch in BLOCKED_CHARS for ch in ln] for ln in lines], dtype=bool)[::-1]
     try:

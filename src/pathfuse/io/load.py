@@ -12,6 +12,8 @@ source                 read by
 ``*.jpg`` ``*.jpeg``
 ``*.bmp``
 ``*.npy``              :func:`~pathfuse.io.image.read_npy` (``resolution`` needed)
+``*.world`` ``*.sdf``  :func:`~pathfuse.io.gazebo.read_gazebo_world` (Gazebo SDF,
+(``.gz`` too)          plain or gzipped; ``resolution`` default 0.05 m)
 =====================  ===========================================================
 
 Examples
@@ -34,18 +36,20 @@ from typing import Any
 
 from pathfuse.generate import paper_map, random_map
 from pathfuse.grid import GridMap
+from pathfuse.io.gazebo import GAZEBO_SUFFIXES, is_gazebo_path, read_gazebo_world
 from pathfuse.io.image import IMAGE_SUFFIXES, read_image, read_npy
 from pathfuse.io.inline import read_rows_yaml
 from pathfuse.io.movingai import read_movingai
 from pathfuse.io.ros import UNKNOWN_POLICIES, _read_ros_doc, load_yaml_mapping
 from pathfuse.result import ConfigError, MapError, MapFormatError
+from pathfuse.validate import short as _shown
 
 __all__ = ["load_map", "map_from_spec", "SUPPORTED_SUFFIXES", "SPEC_SOURCES"]
 
-SUPPORTED_SUFFIXES = (".map", ".yaml", ".yml", *IMAGE_SUFFIXES, ".npy")
+SUPPORTED_SUFFIXES = (".map", ".yaml", ".yml", *IMAGE_SUFFIXES, ".npy", *GAZEBO_SUFFIXES)
 """File name endings :func:`load_map` reads."""
 
-SPEC_SOURCES = ("random", "paper", "movingai", "ros", "image", "npy", "rows")
+SPEC_SOURCES = ("random", "paper", "movingai", "ros", "image", "npy", "rows", "gazebo")
 """The source keys of a map spec; exactly one must be present."""
 
 _SPEC_EXTRA = {
@@ -56,6 +60,7 @@ _SPEC_EXTRA = {
     "image": ("resolution", "origin", "threshold", "negate", "name"),
     "npy": ("resolution", "origin", "name"),
     "rows": ("resolution", "origin", "name"),
+    "gazebo": ("resolution", "bounds", "margin", "name"),
 }
 _RANDOM_KEYS = ("size", "resolution", "obstacles", "density", "seed", "origin",
                 "keep_free", "connect")
@@ -63,7 +68,7 @@ _RANDOM_KEYS = ("size", "resolution", "obstacles", "density", "seed", "origin",
 
 def _check_unknown(unknown: str) -> None:
     if unknown not in UNKNOWN_POLICIES:
-        raise ConfigError(f"unknown must be 'occupied' or 'free', got {unknown!r}")
+        raise ConfigError(f"unknown must be 'occupied' or 'free', got {_shown(unknown)}")
 
 
 def load_map(
@@ -73,6 +78,7 @@ def load_map(
     origin: tuple[float, float] | None = None,
     seed: int | None = None,
     unknown: str = "occupied",
+    bounds: tuple[float, float, float, float] | None = None,
 ) -> GridMap:
     """Load a map from a name or a file, choosing the reader by the file's ending.
 
@@ -92,6 +98,9 @@ def load_map(
         Seed of the generated ``"paper"`` map (default 0); ignored for files.
     unknown : {"occupied", "free"}
         What unknown cells of a ROS map become (see :mod:`pathfuse.io.ros`).
+    bounds : (x_min, y_min, x_max, y_max), optional
+        Extent of a Gazebo world's grid in metres (default: its obstacles
+        grown by 1 m); refused for other sources.
 
     Raises
     ------
@@ -112,12 +121,20 @@ def load_map(
             raise ConfigError("the paper map has a fixed resolution (1 m) and origin (-0.5, -0.5)")
         return paper_map(0 if seed is None else seed)
     if not isinstance(spec, (str, os.PathLike)):
-        raise ConfigError(f"a map is 'paper' or a file path, got {spec!r}")
+        raise ConfigError(f"a map is 'paper' or a file path, got {_shown(spec)}")
     path = Path(os.path.expanduser(os.fspath(spec)))
     suffix = path.suffix.lower()
+    if is_gazebo_path(path):
+        if origin is not None:
+            raise ConfigError(f"{path}: a Gazebo world's grid is placed by bounds=(x_min, "
+                              f"y_min, x_max, y_max), not origin={origin!r}")
+        return read_gazebo_world(path, 0.05 if resolution is None else resolution,
+                                 bounds=bounds)
+    if bounds is not None:
+        raise ConfigError(f"{path}: bounds= applies to Gazebo worlds only")
     if suffix not in SUPPORTED_SUFFIXES:
         raise MapFormatError(
-            f"{path}: unsupported map file type {suffix or '(no extension)'!r}; "
+            f"{path}: unsupported map file type {_shown(suffix or '(no extension)')}; "
             f"supported: 'paper', {', '.join(SUPPORTED_SUFFIXES)}"
         )
     if not path.exists():
@@ -136,7 +153,7 @@ def load_map(
             for key, val in (("resolution", resolution), ("origin", origin)):
                 if val is not None:
                     raise ConfigError(
-                        f"{path}: a ROS map sets its own {key}; do not pass {key}={val!r}"
+                        f"{path}: a ROS map sets its own {key}; do not pass {key}={_shown(val)}"
                     )
             return _read_ros_doc(path, doc, unknown, None)
         if "rows" in doc:
@@ -152,7 +169,7 @@ def load_map(
 
 def _resolve(base_dir: Path, value: object, key: str) -> Path:
     if not isinstance(value, (str, os.PathLike)) or not os.fspath(value).strip():
-        raise ConfigError(f"map spec key '{key}' must be a file path, got {value!r}")
+        raise ConfigError(f"map spec key '{key}' must be a file path, got {_shown(value)}")
     p = Path(os.path.expanduser(os.fspath(value)))
     return p if p.is_absolute() else base_dir / p
 
@@ -161,7 +178,7 @@ def _random_from_spec(value: object, name: str | None) -> GridMap:
     if not isinstance(value, Mapping):
         raise ConfigError(
             f"map spec key 'random' must be a mapping (size, resolution, obstacles | density, "
-            f"seed, ...), got {value!r}"
+            f"seed, ...), got {_shown(value)}"
         )
     for key in value:
         if key not in _RANDOM_KEYS:
@@ -200,6 +217,7 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
         {image: FILE.png, resolution: 0.05, origin: [0, 0], threshold: 0.5, negate: false}
         {npy: FILE.npy, resolution: 0.1, origin: [0, 0]}
         {rows: ["....", ".##."], resolution: 1.0, origin: [0, 0]}
+        {gazebo: FILE.world.gz, resolution: 0.05, bounds: [x0, y0, x1, y1], margin: 1.0}
 
     Every source also takes ``name`` except ``paper``.  A string spec is
     passed to :func:`load_map` (relative paths against ``base_dir``).
@@ -227,7 +245,7 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
             return paper_map(0)
         return load_map(_resolve(base, s, "map"))
     if not isinstance(spec, Mapping):
-        raise ConfigError(f"a map spec must be a mapping or a file name, got {spec!r}")
+        raise ConfigError(f"a map spec must be a mapping or a file name, got {_shown(spec)}")
     sources = [k for k in SPEC_SOURCES if k in spec]
     if len(sources) != 1:
         what = "no" if not sources else f"several ({', '.join(sources)})"
@@ -239,13 +257,13 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
     for key in spec:
         if key != src and key not in allowed:
             raise ConfigError(
-                f"unknown key {key!r} in a '{src}' map spec (allowed with '{src}': "
+                f"unknown key {_shown(key)} in a '{src}' map spec (allowed with '{src}': "
                 f"{', '.join(allowed) if allowed else 'nothing else'})"
             )
     value = spec[src]
     name = spec.get("name")
     if name is not None and not isinstance(name, str):
-        raise ConfigError(f"map spec key 'name' must be a string, got {name!r}")
+        raise ConfigError(f"map spec key 'name' must be a string, got {_shown(name)}")
 
     if src == "random":
         return _random_from_spec(value, name)
@@ -260,7 +278,8 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
         else:
             seed = value
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            raise ConfigError(f"map spec 'paper' seed must be a non-negative integer, got {seed!r}")
+            raise ConfigError(f"map spec 'paper' seed must be a non-negative integer, got"
+                              f" {_shown(seed)}")
         return paper_map(seed)
     if src == "rows":
         doc = {"rows": value}
@@ -270,6 +289,9 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
         return read_rows_yaml(doc)
 
     path = _resolve(base, value, src)
+    if src == "gazebo":
+        return read_gazebo_world(path, spec.get("resolution", 0.05), bounds=spec.get("bounds"),
+                                 margin_m=spec.get("margin", 1.0), name=name)
     if src == "movingai":
         return read_movingai(path, resolution=spec.get("resolution", 1.0),
                              origin=spec.get("origin", (0.0, 0.0)), name=name)
@@ -284,6 +306,6 @@ def map_from_spec(spec: Mapping[str, Any] | str, base_dir: str | os.PathLike[str
         return read_npy(path, spec["resolution"], spec.get("origin", (0.0, 0.0)), name=name)
     negate = spec.get("negate", False)
     if not isinstance(negate, bool):
-        raise ConfigError(f"map spec key 'negate' must be true or false, got {negate!r}")
+        raise ConfigError(f"map spec key 'negate' must be true or false, got {_shown(negate)}")
     return read_image(path, spec["resolution"], spec.get("origin", (0.0, 0.0)),
                       threshold=spec.get("threshold", 0.5), negate=negate, name=name)

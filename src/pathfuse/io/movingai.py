@@ -45,7 +45,9 @@ from pathlib import Path
 import numpy as np
 
 from pathfuse.grid import GridMap
+from pathfuse.limits import check_cells, read_capped
 from pathfuse.result import MapError, MapFormatError
+from pathfuse.validate import short as _shown
 
 __all__ = [
     "read_movingai",
@@ -89,7 +91,7 @@ def cell_to_movingai(row: int, col: int, height: int) -> tuple[int, int]:
 
 def _read_lines(path: Path) -> list[bytes]:
     try:
-        data = path.read_bytes()
+        data = read_capped(path, "the map file")
     except FileNotFoundError:
         raise MapFormatError(f"{path}: no such map file") from None
     except IsADirectoryError:
@@ -107,14 +109,14 @@ def _header_int(path: Path, lineno: int, key: str, text: bytes) -> int:
     if len(parts) != 2 or parts[0].decode("ascii", "replace").lower() != key:
         raise MapFormatError(
             f"{path}, line {lineno}: expected '{key} <integer>', "
-            f"got {text.decode('ascii', 'replace')!r}"
+            f"got {_shown(text.decode('ascii', 'replace'))}"
         )
     raw = parts[1].decode("ascii", "replace")
     try:
         value = int(raw)
     except ValueError:
         raise MapFormatError(
-            f"{path}, line {lineno}: {key} must be an integer, got {raw!r}"
+            f"{path}, line {lineno}: {key} must be an integer, got {_shown(raw)}"
         ) from None
     if value <= 0:
         raise MapFormatError(f"{path}, line {lineno}: {key} must be > 0, got {value}")
@@ -162,14 +164,17 @@ def read_movingai(
         i += 1
     first = lines[i].split() if i < len(lines) else []
     if len(first) != 2 or first[0].lower() != b"type":
+        hint = ""
+        if first[:1] == [b"version"] or path.suffix.lower() == ".scen":
+            hint = " (this is a MovingAI scenario file (.scen), not a map: give the .map first)"
         raise MapFormatError(
             f"{path}, line {i + 1}: expected header 'type octile', "
-            f"got {lines[i].decode('ascii', 'replace')!r}"
+            f"got {_shown(lines[i].decode('ascii', 'replace'))}{hint}"
         )
     if first[1].lower() != b"octile":
         raise MapFormatError(
             f"{path}, line {i + 1}: unsupported map type "
-            f"{first[1].decode('ascii', 'replace')!r} (only 'octile' is supported)"
+            f"{_shown(first[1].decode('ascii', 'replace'))} (only 'octile' is supported)"
         )
     sizes: dict[str, int] = {}
     for _ in range(2):
@@ -184,7 +189,7 @@ def read_movingai(
             want = " or ".join(k for k in ("height", "width") if k not in sizes)
             raise MapFormatError(
                 f"{path}, line {i + 1}: expected '{want} <integer>', "
-                f"got {lines[i].decode('ascii', 'replace')!r}"
+                f"got {_shown(lines[i].decode('ascii', 'replace'))}"
             )
         sizes[key_s] = _header_int(path, i + 1, key_s, lines[i])
     i += 1
@@ -192,8 +197,9 @@ def read_movingai(
         raise MapFormatError(f"{path}, line {i + 1}: file ends inside the header (expected 'map')")
     if lines[i].strip().lower() != b"map":
         got = lines[i].decode("ascii", "replace")
-        raise MapFormatError(f"{path}, line {i + 1}: expected 'map', got {got!r}")
+        raise MapFormatError(f"{path}, line {i + 1}: expected 'map', got {_shown(got)}")
     height, width = sizes["height"], sizes["width"]
+    check_cells(height, width, f"{path}: header")
     first_row = i + 1
     rows = lines[first_row:first_row + height]
     # a final newline leaves one empty string at the end: ignore trailing blank lines
@@ -208,7 +214,7 @@ def read_movingai(
         if extra.strip():
             raise MapFormatError(
                 f"{path}, line {first_row + height + k + 1}: unexpected content after the "
-                f"{height} map rows: {extra[:40].decode('ascii', 'replace')!r}"
+                f"{height} map rows: {_shown(extra[:40].decode('ascii', 'replace'))}"
             )
     grid = np.empty((height, width), dtype=np.bool_)
     for r, row in enumerate(rows):
@@ -224,8 +230,8 @@ def read_movingai(
             col = int(bad[0])
             ch = row[col:col + 1].decode("latin-1")
             raise MapFormatError(
-                f"{path}, line {lineno}, column {col + 1}: unknown map character {ch!r} "
-                f"(free: {FREE_CHARS!r}, blocked: {BLOCKED_CHARS!r})"
+                f"{path}, line {lineno}, column {col + 1}: unknown map character {_shown(ch)} "
+                f"(free: {_shown(FREE_CHARS)}, blocked: {_shown(BLOCKED_CHARS)})"
             )
         grid[r] = codes == 1
     try:
@@ -253,4 +259,8 @@ def write_movingai(grid: GridMap, path: str | os.PathLike[str]) -> None:
     chars = np.where(occ[::-1], ord("@"), ord(".")).astype(np.uint8)
     body = b"\n".join(bytes(row) for row in chars)
     text = f"type octile\nheight {h}\nwidth {w}\nmap\n".encode("ascii") + body + b"\n"
-    Path(path).write_bytes(text)
+    try:
+        Path(path).write_bytes(text)
+    except OSError as exc:
+        raise MapFormatError(f"{path}: cannot write the map file ({exc.strerror or exc})") \
+            from None

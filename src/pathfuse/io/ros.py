@@ -81,11 +81,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from pathfuse.grid import GridMap
 from pathfuse.io.image import load_pixels
 from pathfuse.result import ConfigError, MapError, MapFormatError
+from pathfuse.validate import short as _shown
 
 __all__ = ["read_ros_map", "write_ros_map", "occupancy_values", "ROS_MODES", "UNKNOWN_POLICIES"]
 
@@ -105,39 +105,23 @@ _WRITE_FREE_THRESH = 0.196
 
 
 def load_yaml_mapping(path: Path, what: str = "map YAML") -> dict[str, Any]:
-    """Parse a YAML file that must hold a mapping; every failure is a :class:`MapFormatError`."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise MapFormatError(f"{what} file not found: {path}") from None
-    except IsADirectoryError:
-        raise MapFormatError(f"{what} path is a directory, not a file: {path}") from None
-    except UnicodeDecodeError as exc:
-        raise MapFormatError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
-    except OSError as exc:
-        raise MapFormatError(f"{path}: cannot read {what} ({exc.strerror})") from None
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f", line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or str(exc)
-        raise MapFormatError(f"{path}{where}: YAML syntax error: {problem}") from None
-    if not isinstance(doc, dict):
-        kind = "empty" if doc is None else f"a {type(doc).__name__}"
-        raise MapFormatError(f"{path}: {what} must be a mapping of keys to values, got {kind}")
-    return doc
+    """Parse a YAML file that must hold a mapping; every failure is a :class:`MapFormatError`
+    (or a :class:`~pathfuse.limits.LimitError` for a file beyond the limits of
+    :mod:`pathfuse.safeyaml`)."""
+    from pathfuse.safeyaml import read_yaml_mapping
+
+    return read_yaml_mapping(path, what, MapFormatError)
 
 
 def _number(path: Path, key: str, value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
-        raise MapFormatError(f"{path}: key '{key}' must be a number, got {value!r}")
+        raise MapFormatError(f"{path}: key '{key}' must be a number, got {_shown(value)}")
     try:
         x = float(value)
     except ValueError:
-        raise MapFormatError(f"{path}: key '{key}' must be a number, got {value!r}") from None
+        raise MapFormatError(f"{path}: key '{key}' must be a number, got {_shown(value)}") from None
     if not math.isfinite(x):
-        raise MapFormatError(f"{path}: key '{key}' must be finite, got {value!r}")
+        raise MapFormatError(f"{path}: key '{key}' must be finite, got {_shown(value)}")
     return x
 
 
@@ -150,19 +134,21 @@ def _parse_yaml(path: Path, doc: dict[str, Any]) -> dict[str, Any]:
             )
     image = doc["image"]
     if not isinstance(image, str) or not image.strip():
-        raise MapFormatError(f"{path}: key 'image' must be a non-empty file name, got {image!r}")
+        raise MapFormatError(f"{path}: key 'image' must be a non-empty file name, got"
+                             f" {_shown(image)}")
     image_path = Path(os.path.expanduser(image.strip()))
     if not image_path.is_absolute():
         image_path = path.parent / image_path
 
     res = _number(path, "resolution", doc["resolution"])
     if res <= 0:
-        raise MapFormatError(f"{path}: key 'resolution' must be > 0, got {doc['resolution']!r}")
+        raise MapFormatError(f"{path}: key 'resolution' must be > 0, got"
+                             f" {_shown(doc['resolution'])}")
 
     origin = doc["origin"]
     if not isinstance(origin, (list, tuple)) or len(origin) != 3:
         raise MapFormatError(
-            f"{path}: key 'origin' must be a list [x, y, yaw] of 3 numbers, got {origin!r}"
+            f"{path}: key 'origin' must be a list [x, y, yaw] of 3 numbers, got {_shown(origin)}"
         )
     ox, oy, yaw = (_number(path, "origin", v) for v in origin)
 
@@ -170,11 +156,11 @@ def _parse_yaml(path: Path, doc: dict[str, Any]) -> dict[str, Any]:
     free_t = _number(path, "free_thresh", doc["free_thresh"])
     for key, v in (("occupied_thresh", occ_t), ("free_thresh", free_t)):
         if not 0.0 <= v <= 1.0:
-            raise MapFormatError(f"{path}: key '{key}' must be in [0, 1], got {doc[key]!r}")
+            raise MapFormatError(f"{path}: key '{key}' must be in [0, 1], got {_shown(doc[key])}")
     if free_t >= occ_t:
         raise MapFormatError(
-            f"{path}: key 'free_thresh' ({doc['free_thresh']!r}) must be smaller than "
-            f"'occupied_thresh' ({doc['occupied_thresh']!r})"
+            f"{path}: key 'free_thresh' ({_shown(doc['free_thresh'])}) must be smaller than "
+            f"'occupied_thresh' ({_shown(doc['occupied_thresh'])})"
         )
 
     neg = doc["negate"]
@@ -185,12 +171,12 @@ def _parse_yaml(path: Path, doc: dict[str, Any]) -> dict[str, Any]:
     elif isinstance(neg, str) and neg.strip().lstrip("+-").isdigit():
         negate = int(neg) != 0
     else:
-        raise MapFormatError(f"{path}: key 'negate' must be 0/1 or true/false, got {neg!r}")
+        raise MapFormatError(f"{path}: key 'negate' must be 0/1 or true/false, got {_shown(neg)}")
 
     mode = doc.get("mode", "trinary")
     if mode not in ROS_MODES:
         raise MapFormatError(
-            f"{path}: key 'mode' must be one of {', '.join(ROS_MODES)}, got {mode!r}"
+            f"{path}: key 'mode' must be one of {', '.join(ROS_MODES)}, got {_shown(mode)}"
         )
     return {
         "image": image_path,
@@ -248,7 +234,7 @@ def occupancy_values(
         if alpha is not None:
             out[alpha != 255.0] = -1
     elif mode != "trinary":
-        raise ConfigError(f"mode must be one of {', '.join(ROS_MODES)}, got {mode!r}")
+        raise ConfigError(f"mode must be one of {', '.join(ROS_MODES)}, got {_shown(mode)}")
     return out
 
 
@@ -292,7 +278,7 @@ def read_ros_map(
         ``unknown`` is not "occupied" or "free".
     """
     if unknown not in UNKNOWN_POLICIES:
-        raise ConfigError(f"unknown must be 'occupied' or 'free', got {unknown!r}")
+        raise ConfigError(f"unknown must be 'occupied' or 'free', got {_shown(unknown)}")
     path = Path(yaml_path)
     doc = load_yaml_mapping(path, "ROS map YAML")
     return _read_ros_doc(path, doc, unknown, name)
@@ -303,7 +289,7 @@ def _read_ros_doc(path: Path, doc: dict[str, Any], unknown: str, name: str | Non
     image_path: Path = prm["image"]
     if not image_path.exists():
         raise MapFormatError(
-            f"{path}: image file named by key 'image' ({doc['image']!r}) not found; "
+            f"{path}: image file named by key 'image' ({_shown(doc['image'])}) not found; "
             f"looked for {image_path}"
         )
     grey, alpha = load_pixels(image_path, context=f"{path}: key 'image': ")
@@ -396,7 +382,7 @@ def write_ros_map(
     ipath = ypath.parent / image_name
     suffix = ipath.suffix.lower()
     if suffix not in (".pgm", ".png"):
-        raise MapError(f"image_name must end in .pgm or .png, got {image_name!r}")
+        raise MapError(f"image_name must end in .pgm or .png, got {_shown(image_name)}")
     occ = np.asarray(grid.occupied, dtype=bool)
     pixels = np.where(occ, _PIX_OCCUPIED, _PIX_FREE).astype(np.uint8)
     if keep_unknown:
@@ -426,5 +412,7 @@ def write_ros_map(
         "occupied_thresh": _WRITE_OCCUPIED_THRESH,
         "free_thresh": _WRITE_FREE_THRESH,
     }
+    import yaml
+
     ypath.write_text(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None))
     return ypath

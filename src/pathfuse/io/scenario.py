@@ -35,7 +35,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pathfuse.grid import GridMap
+from pathfuse.limits import read_capped
 from pathfuse.result import MapFormatError
+from pathfuse.validate import short as _shown
 
 __all__ = ["ScenProblem", "read_scen", "scen_map_name"]
 
@@ -76,7 +78,7 @@ class ScenProblem:
 
 def _lines(path: Path) -> list[str]:
     try:
-        data = path.read_bytes()
+        data = read_capped(path, "the scenario file")
     except FileNotFoundError:
         raise MapFormatError(f"{path}: no such scenario file") from None
     except IsADirectoryError:
@@ -96,8 +98,12 @@ def _check_version(path: Path, lines: list[str]) -> None:
         raise MapFormatError(f"{path}, line 1: scenario file is empty")
     parts = lines[0].split()
     if len(parts) != 2 or parts[0] != "version" or parts[1] not in ("1", "1.0"):
+        hint = ""
+        if parts[:1] == ["type"] or path.suffix.lower() == ".map":
+            hint = " (this is a MovingAI map (.map), not a scenario file: give the .map first)"
         raise MapFormatError(
-            f"{path}, line 1: expected 'version 1' or 'version 1.0', got {lines[0][:60]!r}"
+            f"{path}, line 1: expected 'version 1' or 'version 1.0', "
+            f"got {_shown(lines[0][:60])}{hint}"
         )
 
 
@@ -113,7 +119,7 @@ def scen_map_name(path: str | os.PathLike[str]) -> str:
         if line.strip():
             cols = _split(line.strip())
             if len(cols) < 2:
-                raise MapFormatError(f"{path}, line {k}: no map column in {line[:60]!r}")
+                raise MapFormatError(f"{path}, line {k}: no map column in {_shown(line[:60])}")
             return cols[1]
     raise MapFormatError(f"{path}: scenario file holds no problem line")
 
@@ -166,7 +172,7 @@ def read_scen(path: str | os.PathLike[str], grid: GridMap) -> list[ScenProblem]:
                 ints.append(int(cols[k]))
             except ValueError:
                 raise MapFormatError(
-                    f"{path}, line {lineno}: {names[k]} must be an integer, got {cols[k]!r}"
+                    f"{path}, line {lineno}: {names[k]} must be an integer, got {_shown(cols[k])}"
                 ) from None
         bucket, mw, mh, sx, sy, gx, gy = ints
         try:
@@ -176,12 +182,12 @@ def read_scen(path: str | os.PathLike[str], grid: GridMap) -> list[ScenProblem]:
         if not math.isfinite(opt) or opt < 0:
             raise MapFormatError(
                 f"{path}, line {lineno}: optimal length must be a finite number >= 0, "
-                f"got {cols[8]!r}"
+                f"got {_shown(cols[8])}"
             )
         if (mw, mh) != (w, h):
             raise MapFormatError(
                 f"{path}, line {lineno}: scenario map size {mw}x{mh} (WxH) differs from "
-                f"map {grid.name!r} size {w}x{h}"
+                f"map {_shown(grid.name)} size {w}x{h}"
             )
         for what, x, y in (("start", sx, sy), ("goal", gx, gy)):
             if not (0 <= x < w and 0 <= y < h):
@@ -206,4 +212,6 @@ def read_scen(path: str | os.PathLike[str], grid: GridMap) -> list[ScenProblem]:
                 optimal_length=opt * res,
             )
         )
+    if not out:
+        raise MapFormatError(f"{path}: scenario file holds no problem line (only its header)")
     return out

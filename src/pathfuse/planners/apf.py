@@ -74,7 +74,7 @@ class SubgoalController(FieldController):
             problem.goal, p.k_att, p.k_rep, p.rho0_m, self.step_m, self.goal_tolerance_m,
             self.clear_m, p.stall_steps, self.stall_distance_m, ox, oy, g.resolution,
             self.subgoal_tolerance(), self.improved, self.rep_to_goal(), self.rep_exponent(),
-            self.rep_scale(), self.disc_settings())
+            self.rep_scale(), self.disc_settings(), p.safe_step, p.stall_exit)
         self.state = np.zeros(1, dtype=np.int64)
 
     def make_subgoals(self) -> np.ndarray:
@@ -155,6 +155,6 @@ register(PlannerSpec(
     name="apf",
     params_cls=APFParams,
     description="artificial potential field (paper eq. 3-6): one step at a time along the "
-                "resultant force, never into an obstacle",
+                "resultant force, never into an obstacle (safe_step=false: the paper's full step)",
     controller=APFController,
 ))

@@ -28,6 +28,7 @@ import numpy as np
 
 from pathfuse.field.kernels import (
     CODE_BLOCKED,
+    CODE_COLLISION,
     CODE_GOAL,
     CODE_GOAL_SNAP,
     CODE_RUNNING,
@@ -39,6 +40,7 @@ from pathfuse.field.kernels import (
 )
 from pathfuse.field.motion import MARGIN_FRAC
 from pathfuse.geometry import segment_is_clear
+from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.problem import Problem
 from pathfuse.result import Status
 
@@ -71,6 +73,10 @@ class Observed(Protocol):
     def velocity(self) -> np.ndarray: ...
     @property
     def obstacles(self) -> Any: ...  # positions (M, 2), velocities (M, 2), radii (M,), len()
+    @property
+    def heading(self) -> float: ...
+    @property
+    def command(self) -> np.ndarray: ...
 
 
 @dataclass
@@ -116,6 +122,9 @@ class Controller:
     search_budget: ClassVar[bool] = False
     """Whether ``Budget.max_iterations`` caps the global search (``astar``) rather than the
     controller's moves."""
+    native_unicycle: ClassVar[bool] = False
+    """Whether :meth:`act` answers ``(v, omega)`` itself on a diff-drive robot (``dwa``);
+    otherwise :meth:`command` converts its velocity (:mod:`pathfuse.planners.drive`)."""
 
     def __init__(self, problem: Problem, params: Any, plan: Any = None, *,
                  dt: float | None = None, max_speed: float | None = None) -> None:
@@ -147,6 +156,20 @@ class Controller:
     def act(self, obs: Observed) -> np.ndarray:  # pragma: no cover - abstract
         """The velocity ``(vx, vy)`` for this tick."""
         raise NotImplementedError
+
+    def command(self, obs: Observed) -> np.ndarray:
+        """The action for this tick in the robot's terms: :meth:`act`'s velocity for a
+        holonomic robot, ``(v, omega)`` for a diff-drive one (converted by
+        :func:`pathfuse.planners.drive.to_unicycle` unless the controller plans in
+        ``(v, omega)`` itself)."""
+        a = self.act(obs)
+        rb = self.problem.robot
+        if rb is None or not rb.is_diff_drive or self.native_unicycle:
+            return a
+        from pathfuse.planners.drive import to_unicycle
+
+        return to_unicycle(self.problem, rb, float(self.dt), obs,  # type: ignore[arg-type]
+                           a)
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:
@@ -189,8 +212,20 @@ class FieldController(Controller):
             else STALL_FRAC * step
         self.clear_m = problem.robot_radius_m + MARGIN_FRAC * res
         cap = problem.budget.max_iterations
-        self.max_steps = int(cap) if cap is not None else \
-            int(math.ceil(CAP_FACTOR * (g.width + g.height) * res / step)) + 1000
+        most = limit("MAX_STEPS")
+        if cap is not None:
+            # the path keeps every move: more than MAX_STEPS moves are never taken (the
+            # result's message then names the limit)
+            self.max_steps = min(int(cap), most)
+        else:
+            moves = CAP_FACTOR * (g.width + g.height) * res / step + 1000
+            if not moves <= most:
+                raise LimitError(
+                    f"step_m: a step of {step:g} m needs up to {moves:.3g} moves to cross this "
+                    f"map ({g.width} x {g.height} cells of {res:g} m), above the limit of "
+                    f"{most} moves (MAX_STEPS; set the environment variable "
+                    f"{env_name('MAX_STEPS')} to raise it, or use a larger step)")
+            self.max_steps = int(math.ceil(moves))
         size = 1024 if self.online else min(self.max_steps, 1022) + 2
         self.buf = np.empty((size, 2))
         self.buf[0] = problem.start
@@ -255,11 +290,17 @@ class FieldController(Controller):
         where = f"at ({x:.3f}, {y:.3f}), {math.hypot(x - gx, y - gy):.3f} m from the goal"
         if code == CODE_BLOCKED:
             return f"blocked {where}: no collision-free move along the force"
+        if code == CODE_COLLISION:
+            return (f"collision {where}: the full step along the force touches an obstacle "
+                    "(safe_step=false, the paper's rule)")
         if code == CODE_STALLED:
             return (f"local minimum {where}: moved less than {self.stall_distance_m:g} m "
                     f"over the last {self.params.stall_steps} steps")
         if status is Status.MAX_ITERATIONS:
-            return f"step cap of {self.max_steps} steps reached {where}"
+            cap = f"step cap of {self.max_steps} steps"
+            if self.max_steps == limit("MAX_STEPS"):
+                cap += " (MAX_STEPS)"
+            return f"{cap} reached {where}"
         return f"time limit reached after {steps} steps, {where}"
 
     # ------------------------------------------------------------------ online

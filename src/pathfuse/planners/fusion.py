@@ -145,7 +145,7 @@ class FusionController(FieldController):
             problem.goal, p.k_att, p.k_rep, p.rho0_m, p.r1_m, p.r2_m, self.step_m,
             self.goal_tolerance_m, self.clear_m, p.stall_steps, self.stall_distance_m, ox, oy,
             g.resolution, _AHEAD[p.ahead], p.escape, p.escape_points, window, self.online,
-            self.disc_settings())
+            self.disc_settings(), p.safe_step, p.stall_exit)
         self.state = np.zeros(N_S, dtype=np.int64)
         self.kbuf = np.zeros(self.buf.shape[0], dtype=np.int64)
 

@@ -42,6 +42,7 @@ from pathfuse.grid import GridMap
 from pathfuse.problem import Problem
 from pathfuse.result import ConfigError, Status
 from pathfuse.search.astar import HEURISTICS, AStarSearcher, get_searcher
+from pathfuse.validate import short as _shown
 
 __all__ = ["GlobalPlan", "plan_global", "route", "snap_cell"]
 
@@ -150,7 +151,7 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
     """
     if heuristic not in HEURISTICS:
         raise ConfigError(f"heuristic: must be one of {', '.join(map(repr, HEURISTICS))}, "
-                          f"got {heuristic!r}")
+                          f"got {_shown(heuristic)}")
     grid = problem.grid
     r = problem.robot_radius_m
     cs = grid.cspace(r)

@@ -55,6 +55,14 @@ class FieldParams(Checked):
     stall_distance_m: float | None = param(
         None, gt=0, unit="m", optional=True,
         help="a net move below this over stall_steps moves is a stall (default: 2.5 moves)")
+    safe_step: bool = param(True, help="a move that would hit an obstacle slides along it or "
+                                       "shortens, so no move ever collides (ours); false = the "
+                                       "paper: the full step along the force, and a step that "
+                                       "touches an obstacle ends the run as COLLISION")
+    stall_exit: bool = param(True, help="end the run (fusion: escape) when the net move over "
+                                        "stall_steps moves is below stall_distance_m (ours); "
+                                        "false = the paper's loop, which stops only at the goal "
+                                        "or the move cap")
 
 
 @dataclass(frozen=True)

@@ -98,7 +98,7 @@ class Ref6Params(GlobalAStarParams, DiscParams, FieldParams):
     subgoal_tolerance_m: float | None = param(
         None, gt=0, unit="m", optional=True,
         help="a sub-goal (inflection point) is passed within this distance (default: half "
-             "a cell)")
+             "a cell, at least one move)")
     rep_exponent: float = param(2.0, gt=0, help="n of the improved repulsion (Ge and Cui)")
     rep_scale_m: float | None = param(None, gt=0, unit="m", optional=True,
                                       help="L of the improved repulsion (default: rho0_m)")
@@ -117,7 +117,8 @@ class Ref7Params(GlobalAStarParams, DiscParams, FieldParams):
                                             "ends a segment instead")
     subgoal_tolerance_m: float | None = param(
         None, gt=0, unit="m", optional=True,
-        help="a segment end is passed within this distance (default: a quarter cell)")
+        help="a segment end is passed within this distance (default: a quarter cell, at "
+             "least one move)")
 
 
 # --------------------------------------------------------------------- path helpers
@@ -237,9 +238,18 @@ class _RefController(SubgoalController):
     default_subgoal_frac = 0.5
 
     def subgoal_tolerance(self) -> float:
+        """The pass distance of a sub-goal: ``subgoal_tolerance_m`` when given, else a
+        fraction of a cell but never less than one move.
+
+        Moves have a fixed length (``step_m`` offline, ``max_speed * dt`` online), so a
+        sub-goal passed only within less than a move can be jumped over back and forth
+        forever: online on a 0.05 m BARN grid a 0.2 m move straddled a sub-goal passed
+        within 2.5 cm.  With the default step (0.1 cell) offline this changes nothing.
+        """
         tol = self.params.subgoal_tolerance_m
-        return self.default_subgoal_frac * self.problem.grid.resolution if tol is None \
-            else float(tol)
+        if tol is not None:
+            return float(tol)
+        return max(self.default_subgoal_frac * self.problem.grid.resolution, float(self.step_m))
 
     def _with_goal(self, subs: np.ndarray) -> np.ndarray:
         goal = np.asarray(self.problem.goal, dtype=np.float64)

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from pathfuse.result import ConfigError
+from pathfuse.validate import short as _shown
 
 if TYPE_CHECKING:
     from pathfuse.planners.base import Controller
@@ -62,8 +63,9 @@ class PlannerSpec:
     controller : type or None
         The :class:`~pathfuse.planners.base.Controller` subclass; it runs
         offline (:func:`pathfuse.plan`) and online (:func:`pathfuse.simulate`).
-    global_planner : {"astar", None}
-        The global planner run before the controller.
+    global_planner : {"astar", "astar-smooth", "thetastar", "lazy-thetastar", "shortest", None}
+        The global planner run before the controller (grid A*, an any-angle
+        planner of :mod:`pathfuse.planners.anyangle`, or none).
     function : callable or None
         An offline-only planner ``func(grid, start, goal, params, budget)``
         (plug-ins registered with :func:`register_function`).
@@ -83,6 +85,11 @@ class PlannerSpec:
     def uses_astar(self) -> bool:
         """Whether grid A* runs first (its time is part of the planner's)."""
         return self.global_planner == "astar"
+
+    @property
+    def has_global_plan(self) -> bool:
+        """Whether a global planner (A* or an any-angle one) runs before the controller."""
+        return self.global_planner is not None
 
     @property
     def offline(self) -> bool:
@@ -136,7 +143,8 @@ def register_function(name: str, func: Callable[..., Any], params_cls: type,
     return register(PlannerSpec(name, params_cls, description, function=func))
 
 
-_BUILTIN = ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7")
+_BUILTIN = ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7", "astar-smooth", "thetastar",
+            "lazy-thetastar", "shortest", "dwa")
 
 
 def planner_names() -> list[str]:
@@ -158,7 +166,7 @@ def get_planner(name: str) -> PlannerSpec:
         return REGISTRY[_ALIASES.get(name, name)]
     except (KeyError, TypeError):
         raise ConfigError(
-            f"unknown planner {name!r}; choose one of: {', '.join(planner_names())}"
+            f"unknown planner {_shown(name)}; choose one of: {', '.join(planner_names())}"
         ) from None
 
 
@@ -204,5 +212,5 @@ def _load_builtin() -> None:
     _LOADED = True
     import importlib
 
-    for mod in ("astar", "apf", "fusion", "refs"):
+    for mod in ("astar", "apf", "fusion", "refs", "anyangle", "dwa"):
         importlib.import_module(f"pathfuse.planners.{mod}")

@@ -13,6 +13,7 @@ compilation.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -25,7 +26,7 @@ from pathfuse.planners.registry import PlannerSpec
 from pathfuse.problem import Problem
 from pathfuse.result import PlanResult, Status, path_length
 
-__all__ = ["solve", "start_online", "warm", "Stopped"]
+__all__ = ["solve", "start_online", "warm", "Stopped", "PlanInfo"]
 
 _WARM: set[str] = set()
 
@@ -78,18 +79,58 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     deadline = (time.perf_counter() + budget.time_limit_s
                 if budget.time_limit_s is not None else None)
     gp = None
-    if spec.uses_astar:
-        gp = plan_global(problem, params.heuristic, bool(getattr(params, "corner_cutting", False)),
-                         max_expansions=budget.max_iterations if ctrl_cls.search_budget else None)
+    if spec.global_planner is not None:
+        gp = _global(spec, problem, params,
+                     budget.max_iterations if ctrl_cls.search_budget else None)
         if not gp.success:
             msg = gp.message if ctrl_cls.search_budget else f"A* failed: {gp.message}"
             return PlanResult(gp.status, time_s=gp.time_s, planner=spec.name,
                               expansions=gp.expansions, message=msg, info=_astar_info(gp))
     out = ctrl_cls(problem, params, gp).run(deadline)
-    info = {**_astar_info(gp), **out.info} if not ctrl_cls.search_budget else dict(out.info)
+    info = PlanInfo({**_astar_info(gp), **out.info} if not ctrl_cls.search_budget
+                    else out.info)
+    info.bind(problem.grid, out.path, problem.robot_radius_m)
     length = out.length_m if out.length_m is not None else path_length(out.path)
     return PlanResult(out.status, out.path, length, (gp.time_s if gp else 0.0) + out.time_s,
                       spec.name, gp.expansions if gp else 0, out.steps, out.message, info)
+
+
+def _global(spec: PlannerSpec, problem: Problem, params: Any,
+            max_expansions: int | None = None) -> GlobalPlan:
+    """The global plan of ``spec``: grid A*, or an any-angle planner."""
+    if spec.uses_astar:
+        return plan_global(problem, params.heuristic,
+                           bool(getattr(params, "corner_cutting", False)),
+                           max_expansions=max_expansions)
+    from pathfuse.planners.anyangle import plan_any_angle
+
+    return plan_any_angle(str(spec.global_planner), problem, params, max_expansions)
+
+
+class PlanInfo(dict):
+    """``PlanResult.info`` of the registered planners: a dict that also answers
+    ``info["min_clearance_m"]``, the least gap between the robot disc along the path and
+    any occupied square (metres; ``inf`` on an empty map), computed on first access by
+    :func:`pathfuse.metrics.min_clearance` (independently of the planner), so that a
+    caller who never asks pays nothing.  It pickles as a plain dict."""
+
+    _bound: tuple[Any, np.ndarray, float] | None = None
+
+    def bind(self, grid: Any, path: np.ndarray, radius_m: float) -> None:
+        self._bound = (grid, path, float(radius_m))
+
+    def __missing__(self, key: Any) -> Any:
+        if key != "min_clearance_m" or self._bound is None:
+            raise KeyError(key)
+        from pathfuse.metrics import min_clearance
+
+        grid, path, r = self._bound
+        v = min_clearance(grid, path) - r if path.shape[0] else math.nan
+        self[key] = v
+        return v
+
+    def __reduce__(self) -> Any:
+        return (dict, (dict(self),))
 
 
 def _renamed(res: PlanResult, name: str) -> PlanResult:
@@ -123,10 +164,10 @@ def start_online(spec: PlannerSpec, problem: Problem, params: Any, dt: float,
                           "it cannot be simulated")
     warm(spec)
     gp = None
-    if spec.uses_astar:
-        gp = plan_global(problem, params.heuristic,
-                         bool(getattr(params, "corner_cutting", False)))
+    if spec.global_planner is not None:
+        gp = _global(spec, problem, params)
         if not gp.success:
+            what = "A*" if spec.uses_astar else spec.global_planner
             return Stopped(problem, params, gp.status,
-                           f"A* found no path for the robot on the static map: {gp.message}")
+                           f"{what} found no path for the robot on the static map: {gp.message}")
     return spec.controller(problem, params, gp, dt=dt, max_speed=max_speed)

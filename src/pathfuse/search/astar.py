@@ -84,6 +84,7 @@ from pathfuse.search.kernel import (
     _astar_kernel,
     _trace,
 )
+from pathfuse.validate import short as _shown
 
 __all__ = [
     "AStarSearcher",
@@ -183,6 +184,7 @@ class AStarSearcher:
         self._bits = np.empty(_RING_SIZE // 64, dtype=np.uint64)
         self._meta = np.zeros(5, dtype=np.int64)
         self._gen = 0
+        self._closed_gen = -1  # stamp of the cells the last search closed (-1: none)
         self.free_count = int(n - (self._free == 0).sum())
         if labels is None:
             structure = np.ones((3, 3), dtype=bool) if self.corner_cutting else None
@@ -229,7 +231,7 @@ class AStarSearcher:
         """
         if heuristic not in HEURISTICS:
             raise ConfigError(f"heuristic: must be one of {', '.join(map(repr, HEURISTICS))}, "
-                              f"got {heuristic!r}")
+                              f"got {_shown(heuristic)}")
         h, w = self.shape
         (sr, sc), (gr, gc) = (int(v) for v in start_cell), (int(v) for v in goal_cell)
         for what, r, c in (("start", sr, sc), ("goal", gr, gc)):
@@ -255,13 +257,17 @@ class AStarSearcher:
     def _search(self, sr, sc, gr, gc, heuristic, max_expansions, time_limit_s,
                 origin) -> SearchResult:
         t0 = time.perf_counter()
+        self._closed_gen = -1
         if sr == gr and sc == gc:
             ox, oy, res = origin
             return SearchResult(Status.SUCCESS, np.array([[sr, sc]], dtype=np.int64), 0.0, 0,
                                 np.array([[ox + (sc + 0.5) * res, oy + (sr + 0.5) * res]]))
         if self._labels[sr, sc] != self._labels[gr, gc]:
             return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, 0)
-        budget = self.free_count if max_expansions is None else int(max_expansions)
+        # a search never expands more than the free cells: a larger budget (even 10**30)
+        # means no cap, and stays within the kernel's 64-bit integers
+        budget = self.free_count if max_expansions is None else \
+            min(int(max_expansions), self.free_count)
         wp = self._wp
         start = (sr + 1) * wp + sc + 1
         goal = (gr + 1) * wp + gc + 1
@@ -270,6 +276,7 @@ class AStarSearcher:
             self._gen = 0
         self._gen += 2
         gen = self._gen
+        self._closed_gen = gen + 1
         octile = heuristic == "octile"
         chunk = _CHUNK if time_limit_s is not None else budget
         done = 0
@@ -295,6 +302,26 @@ class AStarSearcher:
                 return SearchResult(Status.MAX_ITERATIONS, _NO_CELLS, math.inf, done)
             if time_limit_s is not None and time.perf_counter() - t0 > time_limit_s:
                 return SearchResult(Status.TIMEOUT, _NO_CELLS, math.inf, done)
+
+
+    def closed_mask(self) -> np.ndarray:
+        """The cells the last search closed (expanded), as an (H, W) bool array.
+
+        For looking inside a search (``pathfuse serve`` draws it); nothing on
+        the search path computes it.  All False when the last search expanded
+        nothing (start equal to goal, or answered from connectivity labels).
+
+        >>> occ = np.zeros((3, 4), dtype=bool)
+        >>> s = AStarSearcher(occ)
+        >>> r = s.search((0, 0), (0, 3))
+        >>> int(s.closed_mask().sum()) == r.expansions
+        True
+        """
+        h, w = self.shape
+        if self._closed_gen < 0:
+            return np.zeros((h, w), dtype=bool)
+        stamp = self._stamp.reshape(h + 2, w + 2)[1:-1, 1:-1]
+        return stamp == self._closed_gen
 
 
 # ----------------------------------------------------------------------------- cache

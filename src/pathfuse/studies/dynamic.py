@@ -45,6 +45,7 @@ import numpy as np
 from pathfuse.bench.summary import group_stats, value_stats
 from pathfuse.result import ConfigError
 from pathfuse.stats import markdown_table, write_csv
+from pathfuse.validate import short as _shown
 
 __all__ = [
     "DynamicConfig",
@@ -119,17 +120,25 @@ class DynamicConfig:
             return make_params(spec, params, key=key)
 
         if not _is_int(self.n_seeds) or self.n_seeds < 1:
-            raise ConfigError(f"n_seeds: expected a positive integer, got {self.n_seeds!r}")
+            raise ConfigError(f"n_seeds: expected a positive integer, got {_shown(self.n_seeds)}")
         if not _is_int(self.seed) or self.seed < 0:
-            raise ConfigError(f"seed: expected an integer >= 0, got {self.seed!r}")
+            raise ConfigError(f"seed: expected an integer >= 0, got {_shown(self.seed)}")
         try:
             moving = tuple(self.moving)
         except TypeError:
             raise ConfigError(f"moving: expected a list of integers >= 0, "
-                              f"got {self.moving!r}") from None
+                              f"got {_shown(self.moving)}") from None
         if not moving or not all(_is_int(k) and k >= 0 for k in moving):
-            raise ConfigError(f"moving: expected a list of integers >= 0, got {self.moving!r}")
+            raise ConfigError(f"moving: expected a list of integers >= 0, got"
+                              f" {_shown(self.moving)}")
         object.__setattr__(self, "moving", tuple(dict.fromkeys(int(k) for k in moving)))
+        import inspect
+
+        from pathfuse.world.generate import check_body_ticks, generate_scenarios
+
+        defaults = inspect.signature(generate_scenarios).parameters
+        check_body_ticks(defaults["time_limit"].default, defaults["dt"].default,
+                         max(self.moving))
         try:
             lo, hi = (float(v) for v in self.speed_range)
             ok = math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi
@@ -137,10 +146,10 @@ class DynamicConfig:
             ok = False
         if not ok:
             raise ConfigError(f"speed_range: expected (low, high) with 0 < low <= high m/s, "
-                              f"got {self.speed_range!r}")
+                              f"got {_shown(self.speed_range)}")
         object.__setattr__(self, "speed_range", (lo, hi))
         if isinstance(self.planners, str):
-            raise ConfigError(f"planners: expected a list of names, got {self.planners!r}")
+            raise ConfigError(f"planners: expected a list of names, got {_shown(self.planners)}")
         canonical = []
         for n in tuple(self.planners) or tuple(online_planner_names()):
             try:
@@ -151,13 +160,13 @@ class DynamicConfig:
         object.__setattr__(self, "planners", names)
         if not isinstance(self.params, Mapping):
             raise ConfigError(f"params: expected {{planner: {{key: value}}}}, "
-                              f"got {self.params!r}")
+                              f"got {_shown(self.params)}")
         for n, p in self.params.items():
             if n not in names:
                 raise ConfigError(f"params.{n}: not among the planners run "
                                   f"({', '.join(names)})")
             if not isinstance(p, Mapping):
-                raise ConfigError(f"params.{n}: expected a mapping of parameters, got {p!r}")
+                raise ConfigError(f"params.{n}: expected a mapping of parameters, got {_shown(p)}")
             make_online_params(get_online_planner(n), p, key=f"params.{n}")
 
     def choice(self, name: str) -> dict[str, Any]:
@@ -279,7 +288,7 @@ def run_dynamic(
 
     cfg = config or DynamicConfig()
     if workers is not None and (not _is_int(workers) or workers < 1):
-        raise ConfigError(f"workers: must be a positive integer, got {workers!r}")
+        raise ConfigError(f"workers: must be a positive integer, got {_shown(workers)}")
     exp = dynamic_experiment(cfg)
     specs = exp.expand()
     store = ResultStore(":memory:" if db_path is None else db_path)

@@ -42,6 +42,8 @@ from pathfuse.planners.registry import get_planner, make_params
 from pathfuse.planners.run import start_online, warm
 from pathfuse.problem import Problem
 from pathfuse.result import ConfigError, Status, path_length
+from pathfuse.robot import RobotModel
+from pathfuse.world.robot import RobotSpec, parse_robot
 from pathfuse.world.scenario import Scenario, load_scenario, resolve_planner_choice
 from pathfuse.world.world import World
 
@@ -65,7 +67,9 @@ class Episode:
     positions : (T, 2) float array
         Robot centre at each tick (``positions[0]`` is the start).
     velocities : (T - 1, 2) float array
-        Velocity used over each tick (after clipping to the speed limit).
+        Velocity used over each tick (after clipping to the speed limit): the
+        displacement over the tick divided by ``dt`` (for a diff-drive robot,
+        along the chord of its arc).
     obstacle_positions : (T, K, 2) float array
         Every moving disc's centre at each tick.
     obstacle_radii : (K,) float array
@@ -103,6 +107,11 @@ class Episode:
         The scenario run (map, robot, goal, obstacle specs).
     seed : int or None
         The episode seed.
+    headings : (T,) float array
+        The robot's heading at each tick (rad; see :class:`~pathfuse.world.World`).
+    commands : (T - 1, 2) float array
+        The action applied at each tick: ``(vx, vy)`` for a holonomic robot,
+        ``(v, omega)`` for a diff-drive one (after clipping).
     """
 
     status: Status
@@ -128,6 +137,8 @@ class Episode:
     message: str
     scenario: Scenario = field(repr=False)
     seed: int | None = None
+    headings: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    commands: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
 
     @property
     def reached(self) -> bool:
@@ -145,6 +156,15 @@ class Episode:
     @property
     def robot_radius(self) -> float:
         return self.scenario.robot.radius
+
+    @property
+    def robot(self) -> RobotModel:
+        """The robot's model (:class:`pathfuse.robot.RobotModel`)."""
+        return self.scenario.robot.to_model()
+
+    def trajectory(self) -> np.ndarray:
+        """``(T, 4)``: ``[t, x, y, yaw]`` per tick."""
+        return np.column_stack([self.times, self.positions, self.headings])
 
     def to_dict(self, trajectories: bool = True) -> dict[str, Any]:
         """A JSON-ready dict (``trajectories=False`` leaves out the per-tick arrays)."""
@@ -170,10 +190,13 @@ class Episode:
             "mean_plan_time_s": self.mean_plan_time_s,
             "max_plan_time_s": float(self.plan_times_s.max()) if self.plan_times_s.size else 0.0,
             "setup_time_s": float(self.setup_time_s),
+            "robot_model": self.scenario.robot.model,
         }
         if trajectories:
             d["times"] = self.times.tolist()
             d["positions"] = self.positions.tolist()
+            d["headings"] = self.headings.tolist()
+            d["commands"] = self.commands.tolist()
             d["obstacle_positions"] = self.obstacle_positions.tolist()
             d["obstacle_radii"] = self.obstacle_radii.tolist()
             d["global_path"] = None if self.global_path is None else self.global_path.tolist()
@@ -191,9 +214,10 @@ def _stalled(positions: np.ndarray, n: int, window: int, radius: float) -> bool:
 
 
 def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
-                seed: int | None = None) -> Episode:
+                seed: int | None = None, robot: Any = None) -> Episode:
     """Run the registered ``planner`` (with ``params``: a dict, or its parameter dataclass)
-    through ``scenario``."""
+    through ``scenario`` (with ``robot``, a :class:`~pathfuse.robot.RobotModel` or a
+    ``robot:`` mapping, instead of the scenario's robot)."""
     spec = get_planner(planner)
     if dataclasses.is_dataclass(params) and not isinstance(params, type):
         if type(params) is not spec.params_cls:
@@ -202,20 +226,34 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
         cfg = params
     else:
         cfg = make_params(spec, params)
+    scenario = load_scenario(scenario)
+    if robot is not None:
+        scenario = scenario.replace(robot=_robot_spec(robot))
     world = World(scenario)
     sc = world.scenario
+    model = world.robot
     obs = world.reset(seed)
     n_max = world.n_steps
     k_obs = len(sc.obstacles)
     positions = np.empty((n_max + 1, 2))
     velocities = np.empty((n_max, 2))
+    commands = np.empty((n_max, 2))
+    headings = np.empty(n_max + 1)
+    headings[0] = obs.heading
     sensed = np.zeros((n_max + 1, k_obs), dtype=bool)
     plan_times = np.empty(n_max)
     positions[0] = obs.position
     sensed[0, obs.obstacles.ids] = True
 
-    problem = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius)
+    problem = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius,
+                             clearance_m=sc.robot.clearance, robot=model)
     warm(spec)
+    if model.is_diff_drive:
+        from pathfuse.planners.drive import warmup_drive
+        from pathfuse.sweep import warmup_sweep
+
+        warmup_drive()
+        warmup_sweep()
     t0 = time.perf_counter()
     ctrl: Controller = start_online(spec, problem, cfg, float(sc.dt), float(sc.robot.max_speed))
     setup = time.perf_counter() - t0
@@ -231,7 +269,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
         g0 = np.hypot(q[:, 0] - obs.position[0], q[:, 1] - obs.position[1]) \
             - world.obstacle_radii - world.radius
         min_obst = float(g0.min())
-    window = int(round(sc.stall_time / sc.dt)) if sc.stall_time > 0 else 0
+    window = int(round(min(sc.stall_time / sc.dt, sc.n_steps + 1))) if sc.stall_time > 0 else 0
     status = Status.TIMEOUT
     message = ""
     collision_with = None
@@ -242,11 +280,13 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
         while True:
             acted = obs.tick
             t0 = time.perf_counter()
-            action = ctrl.act(obs)
+            action = ctrl.command(obs)
             plan_times[n - 1] = time.perf_counter() - t0
             obs, terminated, truncated, info = world.step(action)
             positions[n] = obs.position
             velocities[n - 1] = obs.velocity
+            commands[n - 1] = obs.command
+            headings[n] = obs.heading
             sensed[n, obs.obstacles.ids] = True
             min_static = min(min_static, info["static_gap"])
             min_obst = min(min_obst, info["obstacle_gap"])
@@ -305,10 +345,21 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
         message=message,
         scenario=sc,
         seed=world.seed,
+        headings=headings[:n].copy(),
+        commands=commands[:t].copy(),
     )
 
 
-def simulate(scenario: Any, planner: Any = None, seed: int | None = None) -> Episode:
+def _robot_spec(robot: Any) -> RobotSpec:
+    if isinstance(robot, RobotSpec):
+        return robot
+    if isinstance(robot, RobotModel):
+        return RobotSpec.from_model(robot)
+    return parse_robot(robot, ConfigError)
+
+
+def simulate(scenario: Any, planner: Any = None, seed: int | None = None,
+             robot: Any = None) -> Episode:
     """Simulate one episode of a dynamic scenario.
 
     Parameters
@@ -323,6 +374,9 @@ def simulate(scenario: Any, planner: Any = None, seed: int | None = None) -> Epi
     seed : int, optional
         Episode seed (default: the scenario's); the same scenario and seed
         give the same episode, bit for bit.
+    robot : RobotModel or mapping, optional
+        The robot to drive instead of the scenario's (a
+        :class:`pathfuse.robot.RobotModel`, or a ``robot:`` block as a dict).
 
     Returns
     -------
@@ -343,4 +397,4 @@ def simulate(scenario: Any, planner: Any = None, seed: int | None = None) -> Epi
     """
     sc = load_scenario(scenario)
     choice = resolve_planner_choice(sc.planner if planner is None else planner)
-    return run_episode(sc, choice.name, dict(choice.params), seed=seed)
+    return run_episode(sc, choice.name, dict(choice.params), seed=seed, robot=robot)

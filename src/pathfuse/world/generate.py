@@ -46,8 +46,10 @@ import numpy as np
 
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.grid import GridMap
+from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.planners.global_astar import route as global_route
 from pathfuse.result import ConfigError
+from pathfuse.validate import short as _shown
 from pathfuse.world.geometry import segment_static_distance
 from pathfuse.world.obstacles import (
     LinearObstacle,
@@ -69,9 +71,9 @@ def _pair(v: Any, name: str, lo: float) -> tuple[float, float]:
     try:
         a, b = (float(x) for x in v)
     except (TypeError, ValueError):
-        raise ConfigError(f"{name} must be two numbers (low, high), got {v!r}") from None
+        raise ConfigError(f"{name} must be two numbers (low, high), got {_shown(v)}") from None
     if not (math.isfinite(a) and math.isfinite(b)) or a < lo or b < a:
-        raise ConfigError(f"{name} must satisfy {lo:g} <= low <= high, got {v!r}")
+        raise ConfigError(f"{name} must satisfy {lo:g} <= low <= high, got {_shown(v)}")
     return a, b
 
 
@@ -93,7 +95,7 @@ def _random_free_point(rng: np.random.Generator, grid: GridMap, r: float) -> np.
         p = np.array([rng.uniform(x0 + r, x1 - r), rng.uniform(y0 + r, y1 - r)])
         if _disc_ok(grid, p, r):
             return p
-    raise ConfigError(f"found no free spot for a disc of radius {r:g} m on map {grid.name!r}")
+    raise ConfigError(f"found no free spot for a disc of radius {r:g} m on map {_shown(grid.name)}")
 
 
 def _xy(v: np.ndarray) -> tuple[float, float]:
@@ -154,6 +156,22 @@ def _valid(grid: GridMap, ob: ObstacleSpec, start: np.ndarray, goal: np.ndarray,
     if np.hypot(*(p0 - start)) - ob.radius - robot_r < min_start_gap:
         return False
     return bool(np.hypot(*(p0 - goal)) - ob.radius - robot_r >= min_goal_gap)
+
+
+def check_body_ticks(time_limit: Any, dt: Any, moving: int, key: str = "moving") -> None:
+    """Refuse episodes of more than ``MAX_TICKS`` body-ticks (``time_limit / dt x (1 +
+    moving)``) before any disc is placed; values that are not numbers are left to the
+    scenario's own checks."""
+    try:
+        steps = float(time_limit) / float(dt) * (1 + int(moving))
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+        return
+    cap = limit("MAX_TICKS")
+    if steps > cap:
+        raise LimitError(
+            f"{key}: {int(moving)} moving discs over {float(time_limit):g} s in ticks of "
+            f"{float(dt):g} s are {steps:.3g} body-ticks, above the limit of {cap} (MAX_TICKS; "
+            f"set the environment variable {env_name('MAX_TICKS')} to raise it)")
 
 
 def generate_scenarios(
@@ -223,22 +241,23 @@ def generate_scenarios(
     """
     if isinstance(n_scenarios, bool) or not isinstance(n_scenarios, (int, np.integer)) \
             or n_scenarios < 0:
-        raise ConfigError(f"n_scenarios must be an integer >= 0, got {n_scenarios!r}")
+        raise ConfigError(f"n_scenarios must be an integer >= 0, got {_shown(n_scenarios)}")
     if isinstance(moving, bool) or not isinstance(moving, (int, np.integer)) or moving < 0:
-        raise ConfigError(f"moving must be an integer >= 0, got {moving!r}")
+        raise ConfigError(f"moving must be an integer >= 0, got {_shown(moving)}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ConfigError(f"seed must be an integer >= 0, got {seed!r}")
+        raise ConfigError(f"seed must be an integer >= 0, got {_shown(seed)}")
     v_lo, v_hi = _pair(speed_range, "speed_range", 0.0)
     r_lo, r_hi = _pair(radius_range, "radius_range", 0.0)
     if r_lo <= 0:
-        raise ConfigError(f"radius_range must be > 0, got {radius_range!r}")
+        raise ConfigError(f"radius_range must be > 0, got {_shown(radius_range)}")
     kinds = tuple(kinds)
     if not kinds or any(k not in KINDS for k in kinds):
         raise ConfigError(f"kinds must be a non-empty subset of {', '.join(KINDS)}, "
-                          f"got {kinds!r}")
+                          f"got {_shown(kinds)}")
     if placement not in PLACEMENTS:
         raise ConfigError(f"placement must be one of {', '.join(PLACEMENTS)}, "
-                          f"got {placement!r}")
+                          f"got {_shown(placement)}")
+    check_body_ticks(time_limit, dt, moving)  # before placing any disc
     robot = robot or RobotSpec()
     choice = resolve_planner_choice(planner)
     fixed_grid: GridMap | None = None
@@ -277,7 +296,7 @@ def generate_scenarios(
             else:
                 raise ConfigError(
                     f"scenario {i}: could not place moving obstacle {j} after {_ATTEMPTS} "
-                    f"draws (map {grid.name!r} too cluttered?)")
+                    f"draws (map {_shown(grid.name)} too cluttered?)")
         try:
             sc = Scenario(grid=grid, start=(float(s[0]), float(s[1])),
                           goal=(float(g[0]), float(g[1])), robot=robot, dt=float(dt),
@@ -313,5 +332,6 @@ def _start_goal(rng: np.random.Generator, grid: GridMap, r: float, start: Any,
         if d >= want:
             break
     if best is None:
-        raise ConfigError(f"found no connected start and goal for the robot on map {grid.name!r}")
+        raise ConfigError(f"found no connected start and goal for the robot on map"
+                          f" {_shown(grid.name)}")
     return best[1], best[2]

@@ -65,7 +65,9 @@ import yaml
 
 from pathfuse import validate
 from pathfuse.grid import GridMap
+from pathfuse.limits import MAX_SEED, LimitError, env_name, limit
 from pathfuse.result import ConfigError, MapFormatError, PathfuseError
+from pathfuse.validate import short as _shown
 from pathfuse.world.geometry import segment_static_distance
 from pathfuse.world.obstacles import (
     LinearObstacle,
@@ -73,6 +75,7 @@ from pathfuse.world.obstacles import (
     PatrolObstacle,
     RandomWalkObstacle,
 )
+from pathfuse.world.robot import RobotSpec, parse_robot
 
 __all__ = [
     "Scenario",
@@ -95,7 +98,6 @@ SCENARIO_KEYS = ("name", "description", "map", "start", "goal", "robot", "dt", "
                  "goal_tolerance", "stall_time", "stall_radius", "seed", "obstacles", "planner")
 """The keys a scenario file may have."""
 _REQUIRED = ("map", "start", "goal")
-_ROBOT_KEYS = ("radius", "max_speed", "sensing_radius")
 _LINEAR_KEYS = ("position", "velocity", "radius")
 _PATROL_KEYS = ("waypoints", "speed", "radius", "loop")
 _RW_OUTER_KEYS = ("random_walk", "radius")
@@ -104,26 +106,6 @@ _PLANNER_KEYS = ("name", "params")
 
 
 # ---------------------------------------------------------------------- specs
-@dataclass(frozen=True)
-class RobotSpec:
-    """The robot: a disc with a speed limit and a sensing range.
-
-    Attributes
-    ----------
-    radius : float
-        Disc radius in metres (>= 0).
-    max_speed : float
-        Speed limit in m/s (> 0); commanded velocities are clipped to it.
-    sensing_radius : float
-        Moving discs whose surface comes within this many metres of the
-        robot's centre appear in the observation (> 0).
-    """
-
-    radius: float = 0.2
-    max_speed: float = 1.0
-    sensing_radius: float = 3.0
-
-
 @dataclass(frozen=True)
 class PlannerChoice:
     """An online planner's registry name and its parameter overrides."""
@@ -289,6 +271,25 @@ def _check_scene(sc: Scenario) -> None:
     _num(sc.robot.radius, "robot.radius", ge=0)
     _num(sc.robot.max_speed, "robot.max_speed", gt=0)
     _num(sc.robot.sensing_radius, "robot.sensing_radius", gt=0)
+    # the world keeps every disc's trajectory for the whole episode: bound ticks x bodies
+    ticks = sc.time_limit / sc.dt
+    steps = ticks * (1 + len(sc.obstacles))
+    cap = limit("MAX_TICKS")
+    if not steps <= cap:
+        raise LimitError(
+            f"time_limit / dt: {sc.time_limit:g} s / {sc.dt:g} s = {ticks:.3g} ticks for "
+            f"the robot and {len(sc.obstacles)} moving discs ({steps:.3g} body-ticks) is above "
+            f"the limit of {cap} (MAX_TICKS; set the environment variable "
+            f"{env_name('MAX_TICKS')} to raise it)")
+    if not isinstance(sc.robot, RobotSpec):
+        raise ScenarioError(f"robot: must be a RobotSpec, got {type(sc.robot).__name__}")
+    if sc.robot.model == "holonomic" and sc.robot.min_speed != 0:
+        raise ScenarioError(f"robot.min_speed: only a diff-drive robot reverses; got "
+                            f"{sc.robot.min_speed!r} for a holonomic one")
+    try:
+        sc.robot.to_model()  # the model and its limits
+    except ConfigError as exc:
+        raise ScenarioError(str(exc)) from None
     r = sc.robot.radius
     _check_point(sc.grid, sc.start, r, "start", "the robot")
     _check_point(sc.grid, sc.goal, r, "goal", "the robot")
@@ -323,12 +324,16 @@ def _check_scene(sc: Scenario) -> None:
 # the checks of pathfuse.validate, raising ScenarioError
 
 
-def _num(v: Any, key: str, *, gt: float | None = None, ge: float | None = None) -> float:
-    return validate.number(v, key, gt=gt, ge=ge, error=ScenarioError)
+def _num(v: Any, key: str, *, gt: float | None = None, ge: float | None = None,
+         le: float | None = None) -> float:
+    return validate.number(v, key, gt=gt, ge=ge, le=le, error=ScenarioError)
 
 
 def _int(v: Any, key: str, *, ge: int = 0) -> int:
-    return validate.integer(v, key, ge=ge, error=ScenarioError)
+    out = validate.integer(v, key, ge=ge, error=ScenarioError)
+    if out > MAX_SEED:  # seeds are stored as SQLite (64-bit) integers
+        raise ScenarioError(f"{key}: must be an integer in [0, 2**63), got {_shown(out)}")
+    return out
 
 
 def _bool(v: Any, key: str) -> bool:
@@ -348,25 +353,12 @@ def _mapping(v: Any, key: str, allowed: tuple[str, ...], what: str = "a mapping"
 
 
 # ---------------------------------------------------------------------- section parsers
-def _parse_robot(v: Any) -> RobotSpec:
-    if v is None:
-        return RobotSpec()
-    m = _mapping(v, "robot", _ROBOT_KEYS)
-    d = RobotSpec()
-    return RobotSpec(
-        radius=_num(m.get("radius", d.radius), "robot.radius", ge=0),
-        max_speed=_num(m.get("max_speed", d.max_speed), "robot.max_speed", gt=0),
-        sensing_radius=_num(m.get("sensing_radius", d.sensing_radius), "robot.sensing_radius",
-                            gt=0),
-    )
-
-
 def _parse_obstacle(v: Any, index: int) -> ObstacleSpec:
     key = f"obstacles[{index}]"
     if not isinstance(v, Mapping):
         raise ScenarioError(
             f"{key}: must be a mapping with position+velocity, waypoints+speed or random_walk, "
-            f"got {v!r}"
+            f"got {_shown(v)}"
         )
     if "random_walk" in v:
         m = _mapping(v, key, _RW_OUTER_KEYS)
@@ -389,7 +381,7 @@ def _parse_obstacle(v: Any, index: int) -> ObstacleSpec:
         wps = m["waypoints"]
         if not isinstance(wps, (list, tuple)) or len(wps) < 2:
             raise ScenarioError(f"{key}.waypoints: must be a list of at least two [x, y] points, "
-                                f"got {wps!r}")
+                                f"got {_shown(wps)}")
         if "speed" not in m:
             raise ScenarioError(f"{key}.speed: missing (m/s along the waypoints)")
         pts = tuple(_point(p, f"{key}.waypoints[{j}]") for j, p in enumerate(wps))
@@ -432,7 +424,8 @@ def _parse_planner(v: Any) -> PlannerChoice:
     except ConfigError as exc:
         raise ScenarioError(f"planner.name: {exc}") from None
     if not spec.online:
-        raise ScenarioError(f"planner.name: {name!r} only plans offline (it cannot be simulated)")
+        raise ScenarioError(f"planner.name:"
+                            f" {_shown(name)} only plans offline (it cannot be simulated)")
     make_params(spec, params, key="planner.params", error=ScenarioError)
     return PlannerChoice(name=spec.name, params=dict(params))
 
@@ -455,7 +448,7 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
     ``doc["map"]`` may also be a :class:`~pathfuse.grid.GridMap` instance.
     """
     if not isinstance(doc, Mapping):
-        raise ScenarioError(f"a scenario must be a mapping of keys to values, got {doc!r}")
+        raise ScenarioError(f"a scenario must be a mapping of keys to values, got {_shown(doc)}")
     _mapping(doc, "", SCENARIO_KEYS)
     for k in _REQUIRED:
         if k not in doc:
@@ -468,7 +461,8 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
         from pathfuse.io import map_from_spec
 
         if not isinstance(mspec, (Mapping, str)):
-            raise ScenarioError(f"map: must be a map spec mapping or a file name, got {mspec!r}")
+            raise ScenarioError(f"map: must be a map spec mapping or a file name, got"
+                                f" {_shown(mspec)}")
         try:
             grid = map_from_spec(mspec, base_dir)
         except PathfuseError as exc:
@@ -479,14 +473,14 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
             raise err from None
     obstacles = doc.get("obstacles") or []
     if not isinstance(obstacles, (list, tuple)):
-        raise ScenarioError(f"obstacles: must be a list of obstacles, got {obstacles!r}")
+        raise ScenarioError(f"obstacles: must be a list of obstacles, got {_shown(obstacles)}")
     seed = doc.get("seed")
     name = doc.get("name", default_name)
     return Scenario(
         grid=grid,
         start=_point(doc["start"], "start"),
         goal=_point(doc["goal"], "goal"),
-        robot=_parse_robot(doc.get("robot")),
+        robot=parse_robot(doc.get("robot"), ScenarioError),
         dt=_num(doc.get("dt", 0.1), "dt", gt=0),
         time_limit=_num(doc.get("time_limit", 60.0), "time_limit", gt=0),
         goal_tolerance=_num(doc.get("goal_tolerance", 0.25), "goal_tolerance", gt=0),
@@ -503,45 +497,10 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
 
 
 # ---------------------------------------------------------------------- files
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """A SafeLoader that refuses a repeated key instead of keeping the last one."""
-
-
-def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode,
-                       deep: bool = False) -> dict:
-    loader.flatten_mapping(node)
-    seen: dict[Any, Any] = {}
-    for knode, vnode in node.value:
-        k = loader.construct_object(knode, deep=deep)
-        if k in seen:
-            raise yaml.constructor.ConstructorError(
-                None, None, f"duplicate key {k!r}", knode.start_mark)
-        seen[k] = loader.construct_object(vnode, deep=deep)
-    return seen
-
-
-_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
-                                 _construct_mapping)
-
-
 def _read_yaml(path: Path) -> Any:
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise MapFormatError(f"scenario file not found: {path}") from None
-    except IsADirectoryError:
-        raise MapFormatError(f"scenario path is a directory, not a file: {path}") from None
-    except UnicodeDecodeError as exc:
-        raise MapFormatError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
-    except OSError as exc:
-        raise MapFormatError(f"{path}: cannot read the scenario ({exc.strerror})") from None
-    try:
-        return yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 - a SafeLoader subclass
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f", line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or str(exc)
-        raise MapFormatError(f"{path}{where}: YAML error: {problem}") from None
+    from pathfuse.safeyaml import read_yaml
+
+    return read_yaml(path, "scenario", MapFormatError)
 
 
 def load_scenario(scenario: str | os.PathLike[str] | Mapping[str, Any] | Scenario,

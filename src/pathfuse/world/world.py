@@ -12,9 +12,22 @@ depending on Gymnasium and without a reward)::
 
 The action
 ----------
-The action is a **velocity** ``(vx, vy)`` in m/s, held for one tick of
-``dt`` seconds.  Its norm is clipped to ``robot.max_speed`` (direction kept),
-so the robot moves in a straight line from ``p`` to ``p + v * dt``.
+It depends on the robot's model (``robot.model``, :mod:`pathfuse.robot`):
+
+* holonomic (the default): a **velocity** ``(vx, vy)`` in m/s, held for one
+  tick of ``dt`` seconds.  Its norm is clipped to ``robot.max_speed``
+  (direction kept) and, with ``robot.max_accel`` set, its change to
+  ``max_accel * dt``; the robot moves in a straight line from ``p`` to
+  ``p + v * dt``.
+* diff-drive: ``(v, omega)``, the linear speed along the heading and the yaw
+  rate, each clipped to its limit and to the window its acceleration limit
+  reaches from the last command; the robot follows the exact arc
+  (:func:`~pathfuse.sweep.unicycle_pose`) and its heading turns by
+  ``omega * dt``.
+
+The observation's ``heading`` is the diff-drive robot's heading, or the
+direction of a holonomic robot's last non-zero velocity (at reset: the
+robot's ``heading``, or facing the goal).
 
 Collisions (checked over the whole tick, not at its end points)
 ---------------------------------------------------------------
@@ -22,9 +35,12 @@ Collisions (checked over the whole tick, not at its end points)
   or leaves the map - exactly, with
   :func:`~pathfuse.world.geometry.segment_static_distance` (closed-form
   segment-to-square distances; no sampling, so no step size is too large).
+  Along an arc: :func:`~pathfuse.sweep.arc_static_distance` (chords with a
+  provable deviation bound, refined to 1e-9 m where it decides).
 * Moving discs: both centres move linearly over the tick, so their distance
   is minimised in closed form
-  (:func:`~pathfuse.world.geometry.disc_sweep_gaps`).
+  (:func:`~pathfuse.world.geometry.disc_sweep_gaps`); along an arc,
+  :func:`~pathfuse.sweep.arc_disc_gaps`.
 
 ``terminated`` is ``True`` on a collision or when the robot's centre passes
 within ``goal_tolerance`` of the goal during the tick (a collision in the
@@ -61,12 +77,14 @@ Examples
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from pathfuse.result import PathfuseError, QueryError
+from pathfuse.sweep import arc_disc_gaps, arc_static_distance, unicycle_pose
+from pathfuse.validate import short as _shown
 from pathfuse.world.geometry import (
     disc_sweep_gaps,
     point_segment_distance,
@@ -125,6 +143,11 @@ class Observation:
         The goal.
     obstacles : SensedObstacles
         Moving discs within the sensing radius.
+    heading : float
+        The robot's heading (rad; see the module docstring).
+    command : (2,) float array
+        The last action as applied: ``(vx, vy)`` (holonomic) or ``(v, omega)``
+        (diff-drive); zero at reset.
     """
 
     tick: int
@@ -133,6 +156,8 @@ class Observation:
     velocity: np.ndarray
     goal: np.ndarray
     obstacles: SensedObstacles
+    heading: float = 0.0
+    command: np.ndarray = field(default_factory=lambda: np.zeros(2))
 
 
 class World:
@@ -154,9 +179,11 @@ class World:
         self._res = float(g.resolution)
         self.dt = float(sc.dt)
         self.n_steps = sc.n_steps
+        self.robot = sc.robot.to_model()
         self.radius = float(sc.robot.radius)
         self.max_speed = float(sc.robot.max_speed)
         self.sensing_radius = float(sc.robot.sensing_radius)
+        self.diff_drive = self.robot.is_diff_drive
         self.goal = np.array(sc.goal, dtype=np.float64)
         self.obstacle_radii = np.array([ob.radius for ob in sc.obstacles], dtype=np.float64)
         self._tick = -1
@@ -166,6 +193,16 @@ class World:
         self.obstacle_velocities = np.zeros((0, 0, 2))
         self.position = np.array(sc.start, dtype=np.float64)
         self.velocity = np.zeros(2)
+        self.heading = self._initial_heading()
+        self.command = np.zeros(2)
+
+    def _initial_heading(self) -> float:
+        h = self.robot.heading_rad
+        if h is not None:
+            return float(h)
+        sc = self.scenario
+        dx, dy = sc.goal[0] - sc.start[0], sc.goal[1] - sc.start[1]
+        return math.atan2(dy, dx) if (dx or dy) else 0.0
 
     # ------------------------------------------------------------------ state
     @property
@@ -207,7 +244,8 @@ class World:
         if self._tick < 0:
             raise PathfuseError("the world has not been reset; call reset() first")
         return Observation(self._tick, self._tick * self.dt, self.position.copy(),
-                           self.velocity.copy(), self.goal.copy(), self._sense())
+                           self.velocity.copy(), self.goal.copy(), self._sense(),
+                           float(self.heading), self.command.copy())
 
     # ------------------------------------------------------------------ gym-style API
     def reset(self, seed: int | None = None) -> Observation:
@@ -224,22 +262,50 @@ class World:
         self.obstacle_velocities.setflags(write=False)
         self.position = np.array(sc.start, dtype=np.float64)
         self.velocity = np.zeros(2)
+        self.heading = self._initial_heading()
+        self.command = np.zeros(2)
         self._tick = 0
         self._done = False
         return self.observe()
 
     def clip_action(self, action: Any) -> tuple[np.ndarray, bool]:
-        """The velocity the robot will really use, and whether it was clipped."""
+        """The action the robot will really use, and whether it was clipped.
+
+        Holonomic: the velocity, its norm clipped to the speed limit and its
+        change to the acceleration limit.  Diff-drive: ``(v, omega)``, each
+        clipped to its limits and to its acceleration window.
+        """
+        what = "(v, omega)" if self.diff_drive else "velocity (vx, vy)"
         try:
             v = np.asarray(action, dtype=np.float64).reshape(-1)
         except (TypeError, ValueError):
-            raise QueryError(f"action must be a velocity (vx, vy), got {action!r}") from None
+            raise QueryError(f"action must be a {what}, got {_shown(action)}") from None
         if v.shape != (2,) or not np.all(np.isfinite(v)):
-            raise QueryError(f"action must be a finite velocity (vx, vy), got {action!r}")
+            raise QueryError(f"action must be finite {what}, got {_shown(action)}")
+        rb = self.robot
+        dt = self.dt
+        if self.diff_drive:
+            c0 = self.command
+            lin, ang = float(v[0]), float(v[1])
+            lo = max(rb.min_speed_mps, c0[0] - rb.max_accel_mps2 * dt)
+            hi = min(rb.max_speed_mps, c0[0] + rb.max_accel_mps2 * dt)
+            wlo = max(-rb.max_yaw_rate_radps, c0[1] - rb.max_yaw_accel_radps2 * dt)
+            whi = min(rb.max_yaw_rate_radps, c0[1] + rb.max_yaw_accel_radps2 * dt)
+            out = np.array([min(max(lin, lo), hi), min(max(ang, wlo), whi)])
+            return out, bool(out[0] != lin or out[1] != ang)
+        clipped = False
         s = math.hypot(v[0], v[1])
         if s > self.max_speed:
-            return v * (self.max_speed / s), True
-        return v, False
+            v = v * (self.max_speed / s)
+            clipped = True
+        if not math.isinf(rb.max_accel_mps2):
+            dv = v - self.velocity
+            lim = rb.max_accel_mps2 * dt
+            n = math.hypot(dv[0], dv[1])
+            if n > lim * (1.0 + 1e-9):  # beyond rounding
+                v = self.velocity + dv * (lim / n)
+                clipped = True
+        return v, clipped
 
     def step(self, action: Any) -> tuple[Observation, bool, bool, dict[str, Any]]:
         """Move the robot with velocity ``action`` for one tick and the discs with it.
@@ -259,16 +325,35 @@ class World:
         """
         if self._done:
             raise PathfuseError("the episode is over; call reset() to start another")
-        v, clipped = self.clip_action(action)
+        cmd, clipped = self.clip_action(action)
         k = self._tick
         p0 = self.position
-        p1 = p0 + v * self.dt
-        static_gap = self.static_gap(p0, p1)
+        th0 = self.heading
+        arc = self.diff_drive and cmd[0] != 0.0 and cmd[1] != 0.0
+        if self.diff_drive:
+            x1, y1, th1 = unicycle_pose(float(p0[0]), float(p0[1]), th0, float(cmd[0]),
+                                        float(cmd[1]), self.dt)
+            p1 = np.array([x1, y1])
+        else:
+            p1 = p0 + cmd * self.dt
+            th1 = math.atan2(cmd[1], cmd[0]) if (cmd[0] or cmd[1]) else th0
+        if arc:
+            d = arc_static_distance(self._occ, self._ox, self._oy, self._res, float(p0[0]),
+                                    float(p0[1]), th0, float(cmd[0]), float(cmd[1]), self.dt,
+                                    self.radius, self.radius + STATIC_CLEARANCE_CAP_M)
+            static_gap = float(d) - self.radius
+        else:
+            static_gap = self.static_gap(p0, p1)
         obstacle_gap = math.inf
         hit_disc = -1
         if self.obstacle_radii.shape[0]:
-            gaps = disc_sweep_gaps(p0, p1, self.radius, self.obstacle_positions[k],
-                                   self.obstacle_positions[k + 1], self.obstacle_radii)
+            q0, q1 = self.obstacle_positions[k], self.obstacle_positions[k + 1]
+            if arc:
+                gaps = arc_disc_gaps(float(p0[0]), float(p0[1]), th0, float(cmd[0]),
+                                     float(cmd[1]), self.dt, self.radius, q0, q1,
+                                     self.obstacle_radii)
+            else:
+                gaps = disc_sweep_gaps(p0, p1, self.radius, q0, q1, self.obstacle_radii)
             j = int(np.argmin(gaps))
             obstacle_gap = float(gaps[j])
             if obstacle_gap < 0.0:
@@ -279,11 +364,12 @@ class World:
             event, collision = "collision", "static"
         elif hit_disc >= 0:
             event, collision = "collision", hit_disc
-        elif point_segment_distance(self.goal[0], self.goal[1], p0[0], p0[1], p1[0],
-                                    p1[1]) <= self.scenario.goal_tolerance:
+        elif self._passes_goal(p0, p1, th0, cmd, arc):
             event = "reached"
         self.position = p1
-        self.velocity = v
+        self.velocity = (p1 - p0) / self.dt if self.diff_drive else cmd
+        self.heading = float(th1)
+        self.command = cmd
         self._tick = k + 1
         terminated = event is not None
         truncated = (not terminated) and self._tick >= self.n_steps
@@ -291,3 +377,23 @@ class World:
         info = {"event": event, "collision": collision, "static_gap": static_gap,
                 "obstacle_gap": obstacle_gap, "clipped": clipped}
         return self.observe(), terminated, truncated, info
+
+    def _passes_goal(self, p0: np.ndarray, p1: np.ndarray, th0: float, cmd: np.ndarray,
+                     arc: bool) -> bool:
+        """Whether the centre passes within the goal tolerance during the tick (on an arc:
+        by chords, each counted only when it is within the tolerance less its bound)."""
+        gx, gy = self.goal
+        tol = self.scenario.goal_tolerance
+        if not arc:
+            return bool(point_segment_distance(gx, gy, p0[0], p0[1], p1[0], p1[1]) <= tol)
+        v, w = float(cmd[0]), float(cmd[1])
+        n = max(1, int(math.ceil(math.sqrt(abs(v * w) * self.dt ** 2 / 8.0 / 1e-6))))
+        h = self.dt / n
+        e = abs(v * w) * h * h / 8.0
+        ax, ay = float(p0[0]), float(p0[1])
+        for i in range(1, n + 1):
+            bx, by, _ = unicycle_pose(float(p0[0]), float(p0[1]), th0, v, w, i * h)
+            if point_segment_distance(gx, gy, ax, ay, bx, by) + e <= tol:
+                return True
+            ax, ay = bx, by
+        return False

@@ -1,0 +1,155 @@
+"""From a desired velocity to a diff-drive command: the one conversion every controller shares.
+
+The potential-field controllers (``apf``, ``fusion``, ``ref6``, ``ref7``) and
+the A* followers (``astar``, ``astar-replan``) decide a velocity vector
+``u = (ux, uy)`` (where to be after the tick).  A holonomic robot takes it
+as it is.  A diff-drive robot gets ``(v, omega)`` from
+:func:`unicycle_command`, which does this, in this order:
+
+1. **Heading.**  ``err`` is the angle from the robot's heading to ``u``
+   (wrapped to ``[-pi, pi]``).  The desired yaw rate is the fastest from
+   which the turn can still stop at the target heading,
+   ``sign(err) min(|err| / dt, sqrt(2 alpha |err|))`` (``alpha`` the yaw
+   acceleration limit), clipped to ``+-max_yaw_rate`` and to the window
+   ``omega_0 +- alpha dt`` of the last command.
+2. **Speed.**  ``v = |u| cos(err)^2`` while ``|err| < 90 deg``, else 0 (the
+   robot turns towards ``u`` first, slowing as the error grows; it never
+   reverses), clipped to ``[min_speed, max_speed]`` and to the window
+   ``v_0 +- a dt``.
+3. **Admissibility** (Fox et al.'s rule, against the static map).  A speed
+   is taken only when the disc swept along this tick's arc *and then along a
+   straight stop of* ``v^2 / (2 a)`` *metres on the final heading* stays
+   ``radius`` (plus :data:`~pathfuse.geometry.MARGIN_FRAC` of a cell) clear
+   of every occupied square and the map's edge
+   (:func:`~pathfuse.sweep.arc_static_distance`, exact).  Otherwise the
+   speed is lowered in 8 even steps towards the lowest speed of the window;
+   if none passes, the same with the yaw rates of the window nearest the
+   desired one (the last one, 0, either extreme).  If nothing passes, the
+   lowest speed with the desired yaw rate is taken (the world judges it).
+
+So a robot that can brake in time never drives into a wall because of the
+conversion, turning on the spot is always allowed (the footprint is a
+disc), and the moving discs are left to the controller that chose ``u``.
+
+Examples
+--------
+>>> import numpy as np
+>>> occ = np.zeros((4, 4), dtype=np.bool_)
+>>> v, w = unicycle_command(occ, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.1,
+...                         0.0, 1.0, 2.0, 2.0, 4.0, 0.2)
+>>> round(v, 6), round(w, 6)     # straight ahead, from rest: the acceleration window
+(0.2, 0.0)
+>>> v, w = unicycle_command(occ, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.1,
+...                         0.0, 1.0, 2.0, 2.0, 4.0, 0.2)
+>>> round(v, 6), round(w, 6)     # 90 degrees to the left: turn on the spot
+(0.0, 0.4)
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.sweep import arc_static_distance, segment_static_distance, unicycle_pose
+
+__all__ = ["unicycle_command", "admissible", "wrap_angle", "to_unicycle", "warmup_drive"]
+
+
+@njit(cache=True, inline="always")
+def wrap_angle(a: float) -> float:
+    """``a`` wrapped to ``[-pi, pi)``."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit(cache=True)
+def admissible(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
+               th: float, v: float, w: float, dt: float, brake_m: float, clear: float) -> bool:
+    """Whether the arc of ``(v, w)`` over ``dt`` and a straight stop of ``brake_m`` on the
+    final heading keep the disc ``clear`` from every occupied square and the map's edge."""
+    d = arc_static_distance(occ, ox, oy, res, x, y, th, v, w, dt, clear, clear)
+    if d < clear:
+        return False
+    if brake_m > 0.0:
+        bx, by, bth = unicycle_pose(x, y, th, v, w, dt)
+        ex = bx + brake_m * math.cos(bth)
+        ey = by + brake_m * math.sin(bth)
+        if segment_static_distance(occ, ox, oy, res, bx, by, ex, ey, clear) < clear:
+            return False
+    return True
+
+
+@njit(cache=True)
+def unicycle_command(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
+                     th: float, v0: float, w0: float, ux: float, uy: float, dt: float,
+                     vmin: float, vmax: float, amax: float, wmax: float, alpha: float,
+                     clear: float) -> tuple[float, float]:
+    """``(v, omega)`` for the desired velocity ``(ux, uy)`` (see the module docstring)."""
+    s = math.sqrt(ux * ux + uy * uy)
+    v_des = 0.0
+    w_des = 0.0
+    if s > 1e-12:
+        err = wrap_angle(math.atan2(uy, ux) - th)
+        rate = abs(err) / dt
+        if math.isfinite(alpha):
+            rate = min(rate, math.sqrt(2.0 * alpha * abs(err)))
+        w_des = rate if err >= 0.0 else -rate
+        c = math.cos(err)
+        if c > 0.0:
+            v_des = s * c * c
+    wlo = max(-wmax, w0 - alpha * dt)
+    whi = min(wmax, w0 + alpha * dt)
+    w = min(max(w_des, wlo), whi)
+    vlo = max(vmin, v0 - amax * dt)
+    vhi = min(vmax, v0 + amax * dt)
+    v = min(max(v_des, vlo), vhi)
+    # the desired yaw rate first; if no speed is admissible with it, the yaw rates of the
+    # window nearest to it (keep turning, go straight, turn hard either way)
+    for j in range(5):
+        if j == 0:
+            wj = w
+        elif j == 1:
+            wj = min(max(w0, wlo), whi)
+        elif j == 2:
+            wj = min(max(0.0, wlo), whi)
+        elif j == 3:
+            wj = wlo if abs(wlo - w) > abs(whi - w) else whi
+        else:
+            wj = whi if abs(wlo - w) > abs(whi - w) else wlo
+        for k in range(9):
+            vk = v - (v - vlo) * (k / 8.0)
+            brake = 0.0
+            if vk > 0.0 and math.isfinite(amax):
+                brake = vk * vk / (2.0 * amax)
+            if admissible(occ, ox, oy, res, x, y, th, vk, wj, dt, brake, clear):
+                return vk, wj
+    return vlo, w
+
+
+def to_unicycle(problem: Any, robot: Any, dt: float, obs: Any, u: Any) -> np.ndarray:
+    """The diff-drive command for the desired velocity ``u`` of a controller, from the
+    observation's pose and last command (:func:`unicycle_command`)."""
+    g = problem.grid
+    ox, oy = g.origin
+    cmd = obs.command
+    v, w = unicycle_command(
+        g.occupied, float(ox), float(oy), float(g.resolution), float(obs.position[0]),
+        float(obs.position[1]), float(obs.heading), float(cmd[0]), float(cmd[1]),
+        float(u[0]), float(u[1]), float(dt), float(robot.min_speed_mps),
+        float(robot.max_speed_mps), float(robot.max_accel_mps2),
+        float(robot.max_yaw_rate_radps), float(robot.max_yaw_accel_radps2),
+        float(problem.robot_radius_m) + MARGIN_FRAC * float(g.resolution))
+    return np.array([v, w])
+
+
+def warmup_drive() -> None:
+    """Compile (or load from numba's cache) the conversion, for writeable and read-only
+    maps."""
+    for ro in (False, True):
+        occ = np.zeros((3, 3), dtype=np.bool_)
+        occ.setflags(write=not ro)
+        unicycle_command(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 0.0, 0.0, 0.0, 1.0, 0.5, 0.1, 0.0, 1.0,
+                         2.0, 2.0, 4.0, 0.2)

@@ -1,0 +1,334 @@
+"""The Dynamic Window Approach (Fox, Burgard and Thrun, IEEE RA Magazine 1997), as ``"dwa"``.
+
+The local planner that ships with ROS (move_base's ``dwa_local_planner``, Nav2's
+DWB) and the baseline of the BARN challenge: grid A* gives the global path,
+then every control period:
+
+1. **The dynamic window.**  The commands reachable within one tick under the
+   acceleration limits: for a diff-drive robot ``v`` in ``[v0 - a dt, v0 + a
+   dt]`` and ``omega`` in ``[omega0 - alpha dt, omega0 + alpha dt]`` (within
+   the speed and yaw-rate limits), sampled on a ``v_samples x w_samples``
+   grid (plus going straight); for a holonomic robot, velocity vectors of
+   ``v_samples`` speeds x ``w_samples`` directions, moved into the window
+   ``|u - u0| <= a dt``.
+2. **Rollouts.**  Each sample is held for ``horizon_s`` and rolled out in
+   pieces of ``sim_step_s`` (exact arcs; each piece's chord is checked with
+   the exact segment distance to the occupied squares, less the arc's
+   deviation bound).  A sample is *admissible* when this tick's arc and chord
+   are clear and, should the rollout hit the static map later, the robot
+   could still stop before (Fox et al.'s ``v <= sqrt(2 a dist)``, as the
+   travel before the collision exceeding one tick plus the braking
+   distance).  The sensed moving discs are predicted at constant velocity;
+   a sample they would hit within this tick is not admissible.
+3. **Critics** (in the manner of ROS's DWB critics), summed with weights:
+   *path distance* (from the rollout's end to the global path near the
+   robot's progress), *goal distance* (the path left to the goal beyond
+   the end's projection on the path), *heading* (the end heading against
+   the direction to the carrot, ``lookahead_m`` of path beyond that
+   projection), *speed* (``(v_max - v) / v_max``),
+   *obstacle* (``exp(-gap / inflation_decay_m)`` of the least static gap
+   within ``obstacle_range_m``, as Nav2's inflation layer, plus a steep
+   penalty inside the robot's ``clearance_m``) and *moving* (a predicted
+   collision with a sensed disc: 1.5 + 2 x its depth relative to the two radii + 0.5 x how
+   early it starts within the horizon, so that a swerve that makes the overlap shallower
+   beats standing in the disc's way; without one, ``exp(-gap / 0.25 m)`` of the least
+   predicted gap).
+
+The least-cost admissible sample is commanded.  With none, the robot slows
+as hard as it can and turns towards the path ahead.  The robot's progress
+along the path only moves forward, to path points in sight
+(:func:`~pathfuse.field.pathing.advance_progress`), and the global path is
+replanned from the robot's position on the static map every
+``replan_period_s`` (1 s, as Nav2's default behaviour tree does).  Online
+(:func:`pathfuse.simulate`) this runs once per tick with the robot's model;
+offline (:func:`pathfuse.plan`) the controller drives a simulated robot on
+the static map, by default a diff-drive one
+(:data:`pathfuse.robot.DIFF_DRIVE_DEFAULTS`, 1 m/s) with a tick of
+``dt_s``, to within ``goal_tolerance_m`` of the goal (then a clear straight
+move onto it ends the path), a stall (net move below ``stall_distance_m``
+over ``stall_steps`` ticks: ``LOCAL_MINIMUM``) or the tick cap
+(``Budget.max_iterations`` counts ticks).  ``info`` holds ``headings`` and
+``commands`` per tick.
+
+Examples
+--------
+>>> from pathfuse.grid import GridMap
+>>> from pathfuse import plan
+>>> g = GridMap.from_rows(["........", "...##...", "........"])
+>>> r = plan(g, (0.5, 0.5), (7.5, 2.5), planner="dwa", robot_radius_m=0.2)
+>>> r.status.name, r.path[0].tolist(), r.path[-1].tolist()
+('SUCCESS', [0.5, 0.5], [7.5, 2.5])
+>>> r.info["commands"].shape[1], bool(r.info["min_clearance_m"] > 0)
+(2, True)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from pathfuse.field.pathing import advance_progress, polyline_cumlen
+from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
+from pathfuse.planners.base import Controller, Observed, Outcome
+from pathfuse.planners.dwa_kernel import dwa_choose, pack_dwa
+from pathfuse.planners.params import GlobalAStarParams
+from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.problem import Problem
+from pathfuse.result import Status
+from pathfuse.robot import RobotModel
+from pathfuse.sweep import unicycle_pose
+from pathfuse.validate import param
+
+__all__ = ["DWAParams", "DWAController"]
+
+
+@dataclass(frozen=True)
+class DWAParams(GlobalAStarParams):
+    """Parameters of ``dwa`` (the sampling, the horizon and the critics' weights)."""
+
+    v_samples: int = param(7, ge=2, help="linear speeds sampled in the window (holonomic: "
+                                         "speeds from 0 to the limit)")
+    w_samples: int = param(15, ge=3, help="yaw rates sampled in the window (holonomic: "
+                                          "directions)")
+    horizon_s: float = param(2.5, gt=0, unit="s", help="how long each sample is rolled out")
+    sim_step_s: float = param(0.1, gt=0, unit="s", help="length of a rollout piece")
+    dt_s: float = param(0.1, gt=0, unit="s",
+                        help="control period offline (online: the scenario's dt)")
+    path_weight: float = param(1.0, ge=0, unit="1/m",
+                               help="path-distance critic (rollout end to the global path)")
+    goal_weight: float = param(1.0, ge=0, unit="1/m",
+                               help="goal-distance critic (path left beyond the rollout end)")
+    heading_weight: float = param(0.3, ge=0, help="heading critic (per half turn)")
+    speed_weight: float = param(0.2, ge=0, help="speed critic (slower = worse)")
+    obstacle_weight: float = param(0.5, ge=0, help="obstacle critic (static gap)")
+    moving_weight: float = param(8.0, ge=0, help="moving-disc critic (predicted collision)")
+    obstacle_range_m: float = param(0.5, gt=0, unit="m",
+                                    help="static gaps beyond this cost nothing")
+    inflation_decay_m: float = param(0.1, gt=0, unit="m",
+                                     help="the obstacle cost exp(-gap / decay)")
+    lookahead_m: float = param(1.5, gt=0, unit="m",
+                               help="heading critic: aim at the path this far beyond the "
+                                    "rollout end's projection")
+    goal_tolerance_m: float = param(0.25, gt=0, unit="m",
+                                    help="offline: within this a clear straight move onto "
+                                         "the goal ends the path")
+    replan_period_s: float = param(1.0, ge=0, unit="s",
+                                   help="replan the global A* path from the robot's position "
+                                        "on the static map this often (Nav2's default 1 Hz; "
+                                        "0 = never)")
+    stall_steps: int = param(50, ge=1, help="offline: look-back of the stall test, in ticks")
+    stall_distance_m: float = param(0.05, gt=0, unit="m",
+                                    help="offline: a net move below this over stall_steps "
+                                         "ticks is a stall")
+
+
+def _offline_robot(problem: Problem) -> RobotModel:
+    rb = problem.robot
+    if rb is None:
+        return RobotModel.diff_drive(radius_m=problem.robot_radius_m,
+                                     clearance_m=problem.clearance_m)
+    return rb  # type: ignore[no-any-return]
+
+
+class DWAController(Controller):
+    """The Dynamic Window Approach (see the module docstring)."""
+
+    name = "dwa"
+    label = "dynamic window"
+    native_unicycle: ClassVar[bool] = True
+
+    def __init__(self, problem: Problem, params: Any, plan: Any = None, *,
+                 dt: float | None = None, max_speed: float | None = None) -> None:
+        super().__init__(problem, params, plan, dt=dt, max_speed=max_speed)
+        p = params
+        self.robot = rb = _offline_robot(problem) if problem.robot is None or not self.online \
+            else problem.robot
+        self.tick_s = float(dt) if dt is not None else float(p.dt_s)
+        g = problem.grid
+        self.clear_m = problem.robot_radius_m + MARGIN_FRAC * g.resolution
+        self._set_path(np.asarray(plan.waypoints, dtype=np.float64).reshape(-1, 2))
+        self.replan_every = int(round(p.replan_period_s / self.tick_s)) \
+            if p.replan_period_s > 0 else 0
+        self.ticks = 0
+        self.replans = 0
+        ox, oy = g.origin
+        self.f = pack_dwa(
+            self.tick_s, rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2,
+            rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2, problem.robot_radius_m,
+            self.clear_m, max(problem.clearance_m, rb.clearance_m), p.horizon_s, p.sim_step_s,
+            p.v_samples, p.w_samples, p.path_weight, p.goal_weight, p.heading_weight,
+            p.speed_weight, p.obstacle_weight, p.moving_weight, p.obstacle_range_m,
+            p.lookahead_m, p.inflation_decay_m, not rb.is_diff_drive, ox, oy, g.resolution)
+        self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
+        self.no_choice = 0
+
+    def _set_path(self, pts: np.ndarray) -> None:
+        gx, gy = self.problem.goal
+        if pts.shape[0] == 0 or pts[-1, 0] != gx or pts[-1, 1] != gy:
+            pts = np.concatenate([pts, [[gx, gy]]])
+        self.pts = np.require(pts, dtype=np.float64, requirements=("C", "W"))
+        self.cum = polyline_cumlen(self.pts)
+        self.k = 0
+
+    def _replan(self, x: float, y: float) -> None:
+        from pathfuse.planners.global_astar import plan_global
+
+        gp = plan_global(self.problem.with_start((x, y)), self.params.heuristic)
+        self.replans += 1
+        if gp.success:
+            self._set_path(np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2))
+            self.global_path = self.pts
+
+    def _choose(self, x: float, y: float, th: float, c0: float, c1: float, dpos: np.ndarray,
+                dvel: np.ndarray, drad: np.ndarray) -> tuple[float, float]:
+        if self.replan_every and self.ticks and self.ticks % self.replan_every == 0:
+            self._replan(x, y)
+        self.ticks += 1
+        g = self.problem.grid
+        self.k = int(advance_progress(x, y, self.pts, self.cum, self.k, self.reach_m,
+                                      g.occupied, float(g.origin[0]), float(g.origin[1]),
+                                      float(g.resolution), self.clear_m))
+        a0, a1, count, _ = dwa_choose(self.problem.grid.occupied, self.f, x, y, th, c0, c1,
+                                      self.pts, self.cum, self.k, dpos, dvel, drad)
+        if count == 0:
+            self.no_choice += 1
+        return float(a0), float(a1)
+
+    # ------------------------------------------------------------------ online
+    def act(self, obs: Observed) -> np.ndarray:
+        """``(v, omega)`` for a diff-drive robot, ``(vx, vy)`` for a holonomic one."""
+        sens = obs.obstacles
+        if len(sens):
+            dpos = np.require(sens.positions, np.float64, ("C", "W"))
+            dvel = np.require(sens.velocities, np.float64, ("C", "W"))
+            drad = np.require(sens.radii, np.float64, ("C", "W"))
+        else:
+            dpos, dvel, drad = _NO_DISCS
+        cmd = obs.command
+        a0, a1 = self._choose(float(obs.position[0]), float(obs.position[1]),
+                              float(obs.heading), float(cmd[0]), float(cmd[1]), dpos, dvel,
+                              drad)
+        return np.array([a0, a1])
+
+    # ------------------------------------------------------------------ offline
+    def run(self, deadline: float | None) -> Outcome:
+        """Drive a simulated robot to the goal on the static map (see the module docstring)."""
+        pb = self.problem
+        p = self.params
+        g = pb.grid
+        rb = self.robot
+        ox, oy = g.origin
+        x, y = pb.start
+        gx, gy = pb.goal
+        th = rb.heading_rad if rb.heading_rad is not None else (
+            math.atan2(gy - y, gx - x) if (gx != x or gy != y) else 0.0)
+        cap = pb.budget.max_iterations
+        max_ticks = int(cap) if cap is not None else int(math.ceil(
+            10.0 * (g.width + g.height) * g.resolution / (rb.max_speed_mps * self.tick_s)))
+        max_ticks += 0 if cap is not None else 1000
+        path = [(x, y)]
+        heads = [th]
+        cmds: list[tuple[float, float]] = []
+        c0 = c1 = 0.0
+        status = Status.MAX_ITERATIONS
+        msg = ""
+        t0 = time.perf_counter()
+        ticks = 0
+        dpos, dvel, drad = _NO_DISCS
+        holo = not rb.is_diff_drive
+        tol = p.goal_tolerance_m
+        while True:
+            if math.hypot(x - gx, y - gy) <= tol and segment_is_clear(
+                    x, y, gx, gy, g.occupied, ox, oy, g.resolution, self.clear_m):
+                if (x, y) != (gx, gy):
+                    path.append((gx, gy))
+                    heads.append(th)
+                status = Status.SUCCESS
+                msg = f"reached the goal in {ticks} ticks ({ticks * self.tick_s:.1f} s)"
+                break
+            if ticks >= max_ticks:
+                msg = f"tick cap of {max_ticks} ticks reached {self._where(x, y)}"
+                break
+            if deadline is not None and ticks % 64 == 0 and time.perf_counter() > deadline:
+                status = Status.TIMEOUT
+                msg = f"time limit reached after {ticks} ticks, {self._where(x, y)}"
+                break
+            a0, a1 = self._choose(x, y, th, c0, c1, dpos, dvel, drad)
+            if holo:
+                x, y = x + a0 * self.tick_s, y + a1 * self.tick_s
+                if a0 or a1:
+                    th = math.atan2(a1, a0)
+            else:
+                x, y, th = unicycle_pose(x, y, th, a0, a1, self.tick_s)
+            c0, c1 = a0, a1
+            ticks += 1
+            path.append((x, y))
+            heads.append(th)
+            cmds.append((a0, a1))
+            n = len(path)
+            if n > p.stall_steps and math.hypot(
+                    x - path[n - 1 - p.stall_steps][0],
+                    y - path[n - 1 - p.stall_steps][1]) < p.stall_distance_m:
+                status = Status.LOCAL_MINIMUM
+                msg = (f"local minimum {self._where(x, y)}: moved less than "
+                       f"{p.stall_distance_m:g} m over the last {p.stall_steps} ticks")
+                break
+        elapsed = time.perf_counter() - t0
+        info = {"headings": np.array(heads), "commands": np.array(cmds).reshape(-1, 2),
+                "dt_s": self.tick_s, "robot_model": rb.kind, "ticks": ticks,
+                "ticks_without_admissible_command": self.no_choice, "replans": self.replans,
+                "step_time_s": elapsed}
+        return Outcome(status, np.array(path, dtype=np.float64).reshape(-1, 2), ticks,
+                       max(elapsed, 1e-9), msg, info)
+
+    def _where(self, x: float, y: float) -> str:
+        gx, gy = self.problem.goal
+        return f"at ({x:.3f}, {y:.3f}), {math.hypot(x - gx, y - gy):.3f} m from the goal"
+
+    @classmethod
+    def kernels(cls) -> Sequence[Any]:
+        return (dwa_choose, advance_progress)
+
+    @classmethod
+    def warmup(cls) -> None:
+        if _WARM[0]:
+            return
+        from pathfuse.grid import GridMap
+        from pathfuse.result import Budget
+
+        g = GridMap.from_rows(["....", ".#..", "...."])
+        for robot in (RobotModel.diff_drive(radius_m=0.1), RobotModel(radius_m=0.1)):
+            pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5), 0.1, Budget(max_iterations=3),
+                                robot=robot)
+
+            class _P:
+                waypoints = np.array([[0.5, 0.5], [2.5, 0.5], [3.5, 2.5]])
+
+            c = cls(pb, DWAParams(), _P())
+            c.run(None)
+            for ro in (False, True):
+                q = np.ones((1, 2))
+                q.setflags(write=not ro)
+                dwa_choose(g.occupied, c.f, 0.5, 0.5, 0.0, 0.0, 0.0, c.pts, c.cum, 0, q, q,
+                           np.ones(1))
+        _WARM[0] = True
+
+
+_WARM = [False]
+_NO_DISCS = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0))
+
+
+register(PlannerSpec(
+    name="dwa",
+    params_cls=DWAParams,
+    description="A* + the Dynamic Window Approach (Fox et al. 1997; ROS's local planner): "
+                "samples the commands reachable in one tick, rolls them out, scores path, "
+                "goal, heading, speed and clearance",
+    controller=DWAController,
+    global_planner="astar",
+))

@@ -1,0 +1,325 @@
+"""The numba kernel of the Dynamic Window Approach (see :mod:`pathfuse.planners.dwa`).
+
+:func:`dwa_choose` samples the commands reachable within one tick, rolls each
+out over the horizon, scores it and returns the best; :func:`dwa_progress`
+moves the robot's progress index along the global path.  Settings travel in
+one float array (indices ``D_*``), filled by :func:`pack_dwa`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from pathfuse.sweep import (
+    arc_deviation_bound,
+    disc_sweep_gaps,
+    segment_static_distance,
+    unicycle_pose,
+)
+
+__all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "N_D"]
+
+(D_DT, D_VMIN, D_VMAX, D_AMAX, D_WMAX, D_ALPHA, D_RADIUS, D_CLEAR, D_MARGIN, D_HORIZON,
+ D_SIMDT, D_NV, D_NW, D_WPATH, D_WGOAL, D_WHEAD, D_WSPEED, D_WOBS, D_WDYN, D_RANGE,
+ D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES) = range(26)
+N_D = 26
+
+
+def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
+             n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
+             decay, holonomic, ox, oy, res):
+    """The settings array of :func:`dwa_choose`."""
+    f = np.zeros(N_D)
+    vals = (dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
+            n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
+            decay, 1.0 if holonomic else 0.0, ox, oy, res)
+    for i, v in enumerate(vals):
+        f[i] = float(v)
+    return f
+
+
+@njit(cache=True, inline="always")
+def _wrap(a):
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit(cache=True)
+def dwa_progress(x, y, pts, cum, k, reach_m):
+    """The nearest path point to ``(x, y)`` among those from ``k`` up to ``reach_m`` of path
+    beyond it (never behind ``k``)."""
+    m = pts.shape[0]
+    best = k
+    ex = x - pts[k, 0]
+    ey = y - pts[k, 1]
+    bd = ex * ex + ey * ey
+    j = k + 1
+    while j < m and cum[j] - cum[k] <= reach_m:
+        ex = x - pts[j, 0]
+        ey = y - pts[j, 1]
+        d = ex * ex + ey * ey
+        if d < bd:
+            bd = d
+            best = j
+        j += 1
+    return best
+
+
+@njit(cache=True, inline="always")
+def _point_seg(px, py, ax, ay, bx, by):
+    vx = bx - ax
+    vy = by - ay
+    l2 = vx * vx + vy * vy
+    t = 0.0
+    if l2 > 0.0:
+        t = ((px - ax) * vx + (py - ay) * vy) / l2
+        t = min(max(t, 0.0), 1.0)
+    ex = px - (ax + t * vx)
+    ey = py - (ay + t * vy)
+    return math.sqrt(ex * ex + ey * ey)
+
+
+@njit(cache=True)
+def _local_goal(pts, cum, k, look):
+    """Index of the path point ``look`` metres of path beyond ``pts[k]`` (the last one)."""
+    m = pts.shape[0]
+    j = k
+    while j + 1 < m and cum[j + 1] - cum[k] <= look:
+        j += 1
+    if j + 1 < m:
+        j += 1
+    return j
+
+
+@njit(cache=True)
+def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
+    """Score one sample: ``out = [cost, admissible, first_tick_clear]``."""
+    ox = f[D_OX]
+    oy = f[D_OY]
+    res = f[D_RES]
+    dt = f[D_DT]
+    clear = f[D_CLEAR]
+    radius = f[D_RADIUS]
+    horizon = f[D_HORIZON]
+    h = f[D_SIMDT]
+    rng = f[D_RANGE]
+    n = max(1, int(math.ceil(horizon / h - 1e-9)))
+    e = arc_deviation_bound(v, w, h)
+    cap = clear + rng + e
+    dmin = cap
+    speed = abs(v)
+    amax = f[D_AMAX]
+    brake = 0.0
+    if math.isfinite(amax) and amax > 0.0:
+        brake = speed * speed / (2.0 * amax)
+    need = speed * dt + brake  # travel before the robot could stand still
+    ax = x
+    ay = y
+    ok = True
+    first_ok = True
+    travelled = 0.0
+    n_disc = drad.shape[0]
+    dyn = 0.0
+    qa = np.empty((1, 2))
+    qb = np.empty((1, 2))
+    rr = np.empty(1)
+    pa = np.empty(2)
+    pb = np.empty(2)
+    gmin = np.inf
+    dmaxr = 0.0
+    tc = np.inf
+    ex = x
+    ey = y
+    eth = th
+    for i in range(1, n + 1):
+        t = min(i * h, horizon)
+        bx, by, bth = unicycle_pose(x, y, th, v, w, t)
+        d = segment_static_distance(occ, ox, oy, res, ax, ay, bx, by, cap) - e
+        if t <= dt + 1e-12:
+            # the tick itself: the arc (lower bound) and the chord (the path offline) clear
+            if d < clear:
+                first_ok = False
+                ok = False
+                break
+            if e > 0.0 and segment_static_distance(occ, ox, oy, res, ax, ay, bx, by,
+                                                   clear) < clear:
+                first_ok = False
+                ok = False
+                break
+        if d < clear:
+            if travelled < need:
+                ok = False  # it could not stop before this collision
+            break
+        if d < dmin:
+            dmin = d
+        for j in range(n_disc):
+            pa[0] = ax
+            pa[1] = ay
+            pb[0] = bx
+            pb[1] = by
+            t0 = t - h if t - h > 0.0 else 0.0
+            qa[0, 0] = dpos[j, 0] + dvel[j, 0] * t0
+            qa[0, 1] = dpos[j, 1] + dvel[j, 1] * t0
+            qb[0, 0] = dpos[j, 0] + dvel[j, 0] * t
+            qb[0, 1] = dpos[j, 1] + dvel[j, 1] * t
+            rr[0] = drad[j]
+            g = disc_sweep_gaps(pa, pb, radius, qa, qb, rr)[0] - e
+            if g < gmin:
+                gmin = g
+                dmaxr = drad[j]
+            if g < 0.0 and t0 < tc:
+                tc = t0
+        travelled += abs(v) * (t - (i - 1) * h)
+        ax = bx
+        ay = by
+        ex = bx
+        ey = by
+        eth = bth
+    out[1] = 1.0 if ok else 0.0
+    out[2] = 1.0 if first_ok else 0.0
+    if not ok:
+        out[0] = np.inf
+        return
+    if n_disc > 0:
+        if tc <= dt:
+            out[1] = 0.0  # a predicted collision within this tick
+            out[0] = np.inf
+            return
+        if tc < np.inf:
+            # how deep the predicted overlap gets (so a swerve that shrinks it beats
+            # standing in the disc's way), and how soon it starts
+            dyn = 1.5 + 2.0 * min(-gmin / (radius + dmaxr), 1.0) + 0.5 * (horizon - tc) / horizon
+        elif gmin < np.inf:
+            dyn = math.exp(-max(gmin, 0.0) / 0.25)
+    # the end point against the path near the progress index: its distance to the path and
+    # how much path is left beyond its projection
+    m = pts.shape[0]
+    pd = np.inf
+    s_end = cum[k]
+    j = k
+    while j < m - 1 and j < jg:
+        ax0 = pts[j, 0]
+        ay0 = pts[j, 1]
+        vx = pts[j + 1, 0] - ax0
+        vy = pts[j + 1, 1] - ay0
+        l2 = vx * vx + vy * vy
+        tt = 0.0
+        if l2 > 0.0:
+            tt = min(max(((ex - ax0) * vx + (ey - ay0) * vy) / l2, 0.0), 1.0)
+        dd = math.hypot(ex - (ax0 + tt * vx), ey - (ay0 + tt * vy))
+        if dd < pd:
+            pd = dd
+            s_end = cum[j] + tt * (cum[j + 1] - cum[j])
+        j += 1
+    if pd == np.inf:
+        pd = math.hypot(ex - pts[m - 1, 0], ey - pts[m - 1, 1])
+        s_end = cum[m - 1]
+    left = cum[m - 1] - s_end
+    # the carrot: lookahead_m of path beyond the projection
+    sc = min(s_end + f[D_LOOK], cum[m - 1])
+    j = k
+    while j + 1 < m - 1 and cum[j + 1] < sc:
+        j += 1
+    seg = cum[j + 1] - cum[j] if j + 1 < m else 0.0
+    u = (sc - cum[j]) / seg if seg > 0.0 else 0.0
+    u = min(max(u, 0.0), 1.0)
+    gx = pts[j, 0] + u * (pts[min(j + 1, m - 1), 0] - pts[j, 0])
+    gy = pts[j, 1] + u * (pts[min(j + 1, m - 1), 1] - pts[j, 1])
+    gd = math.hypot(gx - ex, gy - ey)
+    if f[D_HOLO] == 1.0:
+        hd = math.atan2(gy - y, gx - x)
+        he = abs(_wrap(hd - th)) / math.pi if speed > 0.0 else 0.5
+    else:
+        he = abs(_wrap(math.atan2(gy - ey, gx - ex) - eth)) / math.pi if gd > 1e-9 else 0.0
+    gap = dmin - radius
+    obs = math.exp(-max(gap, 0.0) / f[D_DECAY]) if dmin < cap else 0.0
+    margin = f[D_MARGIN]
+    if margin > 0.0 and gap < margin:
+        obs += 10.0 * (margin - gap) / margin
+    out[0] = (f[D_WPATH] * pd + f[D_WGOAL] * left + f[D_WHEAD] * he
+              + f[D_WSPEED] * (f[D_VMAX] - v) / f[D_VMAX] + f[D_WOBS] * obs + f[D_WDYN] * dyn)
+
+
+@njit(cache=True)
+def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
+    """The best command from the dynamic window.
+
+    ``(c0, c1)`` is the last command: ``(v, omega)`` for a diff-drive robot,
+    ``(vx, vy)`` for a holonomic one.  Returns ``(a0, a1, admissible_count,
+    cost)`` with ``(a0, a1)`` in the same terms; with no admissible sample, the
+    slowest command of the window turning towards the local goal.
+    """
+    dt = f[D_DT]
+    vmax = f[D_VMAX]
+    amax = f[D_AMAX]
+    nv = int(f[D_NV])
+    nw = int(f[D_NW])
+    jg = _local_goal(pts, cum, k, f[D_VMAX] * f[D_HORIZON] + f[D_LOOK] + 1.0)
+    out = np.zeros(3)
+    best = np.inf
+    b0 = 0.0
+    b1 = 0.0
+    count = 0
+    if f[D_HOLO] == 1.0:
+        # velocity vectors: speeds x directions, within |u - u0| <= a dt
+        lim = amax * dt
+        for i in range(nv):
+            s = vmax * i / (nv - 1)
+            for j in range(nw if i > 0 else 1):
+                a = 2.0 * math.pi * j / nw
+                ux = s * math.cos(a)
+                uy = s * math.sin(a)
+                if math.isfinite(lim):
+                    dx = ux - c0
+                    dy = uy - c1
+                    dn = math.hypot(dx, dy)
+                    if dn > lim:  # onto the window's edge (a hair inside: no clipping)
+                        ux = c0 + dx * (lim / dn) * (1.0 - 1e-12)
+                        uy = c1 + dy * (lim / dn) * (1.0 - 1e-12)
+                        sn = math.hypot(ux, uy)
+                        if sn > vmax:
+                            ux *= vmax / sn * (1.0 - 1e-12)
+                            uy *= vmax / sn * (1.0 - 1e-12)
+                sp = math.hypot(ux, uy)
+                hd = math.atan2(uy, ux) if sp > 0.0 else th
+                _rollout(occ, f, x, y, hd, sp, 0.0, pts, cum, k, jg, dpos, dvel, drad, out)
+                if out[1] == 1.0:
+                    count += 1
+                    if out[0] < best:
+                        best = out[0]
+                        b0 = ux
+                        b1 = uy
+        if count == 0:  # nothing admissible: slow down as hard as the window allows
+            sc = 0.0
+            if math.isfinite(lim):
+                sc = max(0.0, 1.0 - lim / max(math.hypot(c0, c1), 1e-300))
+            return c0 * sc, c1 * sc, 0, np.inf
+        return b0, b1, count, best
+    vlo = max(f[D_VMIN], c0 - amax * dt)
+    vhi = min(vmax, c0 + amax * dt)
+    wlo = max(-f[D_WMAX], c1 - f[D_ALPHA] * dt)
+    whi = min(f[D_WMAX], c1 + f[D_ALPHA] * dt)
+    for i in range(nv):
+        # exactly on the window's edges (the world clips anything beyond them)
+        v = vhi if i == nv - 1 else min(max(vlo + (vhi - vlo) * (i / (nv - 1)), vlo), vhi)
+        for j in range(nw + 1):
+            if j < nw:
+                w = whi if j == nw - 1 else min(max(wlo + (whi - wlo) * (j / (nw - 1)), wlo),
+                                                whi)
+            else:
+                w = min(max(0.0, wlo), whi)  # always try going straight
+            _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out)
+            if out[1] == 1.0:
+                count += 1
+                if out[0] < best:
+                    best = out[0]
+                    b0 = v
+                    b1 = w
+    if count == 0:
+        # nothing admissible: as slow as possible, turning towards the local goal
+        err = _wrap(math.atan2(pts[jg, 1] - y, pts[jg, 0] - x) - th)
+        w = min(max(err / dt, wlo), whi)
+        return vlo, w, 0, np.inf
+    return b0, b1, count, best

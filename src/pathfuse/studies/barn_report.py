@@ -1,0 +1,178 @@
+"""Tables of a BARN study (:mod:`pathfuse.studies.barn`): per planner, next to the published DWA.
+
+:func:`summary_rows` gives, per planner, the episodes, the success, collision
+and timeout counts and rates with 95 % Wilson intervals, the mean metric over
+every episode (failures count 0) with a 95 % Student-t interval, and the mean
+time over the successful episodes with its interval.  :func:`markdown_report`
+lays them out with the challenge's published DWA baseline as a reference line:
+that baseline was measured in Gazebo with a real navigation stack (laser
+scans, costmaps, physics), so it is a landmark, not a like-for-like comparison.
+
+Examples
+--------
+>>> recs = [{"world": 0, "planner": "fusion", "status": "success", "time_s": 6.0,
+...          "metric": 0.5}, {"world": 1, "planner": "fusion", "status": "collision",
+...          "time_s": 2.0, "metric": 0.0}]
+>>> r = summary_rows(recs, ["fusion"])[0]
+>>> r["episodes"], r["success"], r["collision"], r["metric_mean"], r["time_mean_s"]
+(2, 1, 1, 0.25, 6.0)
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from pathfuse.stats import markdown_table, mean_ci, wilson_ci, write_csv
+
+__all__ = ["summary_rows", "markdown_report", "text_table", "write_barn_outputs",
+           "OUTCOMES"]
+
+OUTCOMES = ("success", "collision", "timeout")
+
+
+def summary_rows(records: Sequence[Mapping[str, Any]],
+                 planners: Sequence[str]) -> list[dict[str, Any]]:
+    """One row per planner (see the module docstring)."""
+    rows = []
+    for name in planners:
+        recs = [r for r in records if r["planner"] == name]
+        n = len(recs)
+        row: dict[str, Any] = {"planner": name, "episodes": n}
+        for o in OUTCOMES:
+            k = sum(r["status"] == o for r in recs)
+            p, lo, hi = wilson_ci(k, n)
+            row.update({o: k, f"{o}_rate": p, f"{o}_ci_low": lo, f"{o}_ci_high": hi})
+        # Student-t intervals, clipped to the values the quantity can take (metric 0..0.5,
+        # time >= 0): a skewed sample of mostly zeros can put the bare interval below 0
+        m, lo, hi = mean_ci([float(r["metric"]) for r in recs])
+        row.update({"metric_mean": m, "metric_ci_low": _clip(lo, 0.0, 0.5),
+                    "metric_ci_high": _clip(hi, 0.0, 0.5)})
+        t, tlo, thi = mean_ci([float(r["time_s"]) for r in recs if r["status"] == "success"])
+        row.update({"time_mean_s": t, "time_ci_low_s": _clip(tlo, 0.0, math.inf),
+                    "time_ci_high_s": thi})
+        detail: dict[str, int] = {}
+        for r in recs:
+            s = str(r.get("pathfuse_status", ""))
+            if r["status"] == "timeout" and s and s != "TIMEOUT":
+                detail[s] = detail.get(s, 0) + 1
+        row["timeout_detail"] = ", ".join(f"{k} {v}" for k, v in sorted(detail.items()))
+        rows.append(row)
+    return rows
+
+
+def _clip(v: float, lo: float, hi: float) -> float:
+    return v if math.isnan(v) else min(max(v, lo), hi)
+
+
+def _rate(r: Mapping[str, Any], key: str) -> str:
+    if not r["episodes"]:
+        return "n/a"
+    return (f"{r[key]}/{r['episodes']} = {100 * r[f'{key}_rate']:.1f}% "
+            f"[{100 * r[f'{key}_ci_low']:.1f}, {100 * r[f'{key}_ci_high']:.1f}]")
+
+
+def _mean(r: Mapping[str, Any], key: str, unit: str = "", fmt: str = "{:.4f}") -> str:
+    m = r[f"{key}_mean{unit}"]
+    if not math.isfinite(m):
+        return "n/a"
+    lo, hi = r[f"{key}_ci_low{unit}"], r[f"{key}_ci_high{unit}"]
+    return f"{fmt.format(m)} [{fmt.format(lo)}, {fmt.format(hi)}]"
+
+
+def _table(rows: Sequence[Mapping[str, Any]], baseline: Mapping[str, Any] | None
+           ) -> list[list[str]]:
+    head = ["planner", "success [95% CI]", "collision", "timeout", "mean metric [95% CI]",
+            "mean time (s), successes [95% CI]"]
+    table = [head]
+    for r in rows:
+        to = _rate(r, "timeout")
+        if r.get("timeout_detail"):
+            to += f" (of which {r['timeout_detail']})"
+        table.append([r["planner"], _rate(r, "success"), _rate(r, "collision"), to,
+                      _mean(r, "metric"), _mean(r, "time", "_s", "{:.2f}")])
+    if baseline:
+        table.append([f"*{baseline['planner']}*", f"*{100 * baseline['success']:.1f}%*",
+                      f"*{100 * baseline['collision']:.1f}%*",
+                      f"*{100 * baseline['timeout']:.1f}%*", f"*{baseline['metric']:.4f}*",
+                      f"*{baseline['time_s']:.2f}*"])
+    return table
+
+
+def markdown_report(run: Any, rows: Sequence[Mapping[str, Any]] | None = None) -> str:
+    """The study as Markdown: the setup, the table with the DWA reference line, notes."""
+    from pathfuse.studies.barn import (
+        BARN_GOAL,
+        BARN_GOAL_TOLERANCE_M,
+        BARN_START,
+        BARN_TIME_LIMIT_S,
+        DWA_BASELINE,
+    )
+
+    cfg = run.config
+    rows = summary_rows(run.records, cfg.planners) if rows is None else rows
+    robot = ", ".join(f"{k} {v:g}" if isinstance(v, (int, float)) else f"{k} {v}"
+                      for k, v in cfg.robot.items())
+    idx = [w.index for w in run.worlds]
+    return (
+        "# BARN: the challenge's protocol on its Gazebo worlds\n\n"
+        f"{len(idx)} worlds ({_span(idx)}) from {cfg.directory}, rasterised at "
+        f"{cfg.resolution:g} m; start {BARN_START}, goal {BARN_GOAL} (reached within "
+        f"{BARN_GOAL_TOLERANCE_M:g} m), {BARN_TIME_LIMIT_S:g} s limit; robot: {robot}; "
+        f"dt {cfg.dt:g} s.  {len(run.records)} episodes in {run.wall_s:.1f} s with "
+        f"{run.workers} worker{'s' if run.workers != 1 else ''}.\n\n"
+        f"{markdown_table(_table(rows, DWA_BASELINE))}\n\n"
+        "Rates carry 95% Wilson intervals and means 95% Student-t intervals (clipped to "
+        "the values the quantity can take).  The metric "
+        "is the challenge's (success x optimal_time / clip(time, 2 optimal_time, 8 "
+        "optimal_time), at most 0.5) averaged over every episode, failures counting 0; the "
+        "mean time is over the successful episodes only.  A timeout is every episode that "
+        "neither reached the goal nor collided: the planner's own give-ups (no path, "
+        "stalled) are listed beside it.\n\n"
+        f"*{DWA_BASELINE['planner']}*: {DWA_BASELINE['note']}.  pathfuse simulates a disc "
+        "robot with exact continuous collision checks against the occupied cells, perfect "
+        "localisation and the map known in advance, so its rates are not those a Gazebo "
+        "run would give.\n"
+    )
+
+
+def _span(idx: Sequence[int]) -> str:
+    if not idx:
+        return "none"
+    if list(idx) == list(range(idx[0], idx[0] + len(idx))):
+        return f"indices {idx[0]}-{idx[-1]}"
+    return f"indices {idx[0]}..{idx[-1]}, {len(idx)} of them"
+
+
+def text_table(rows: Sequence[Mapping[str, Any]]) -> str:
+    """The planner table as aligned plain text (what the command prints)."""
+    from pathfuse.studies.barn import DWA_BASELINE
+
+    table = [[c.strip("*") for c in row] for row in _table(rows, DWA_BASELINE)]
+    widths = [max(len(r[i]) for r in table) for i in range(len(table[0]))]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip()
+                     for r in table)
+
+
+def write_barn_outputs(run: Any, out_dir: str | Path) -> dict[str, Path]:
+    """Write ``barn.md``, ``summary.csv`` and ``episodes.csv`` (no trajectories) into
+    ``out_dir``; return their paths."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = summary_rows(run.records, run.config.planners)
+    files = {"report_md": out / "barn.md", "summary_csv": out / "summary.csv",
+             "episodes_csv": out / "episodes.csv"}
+    files["report_md"].write_text(markdown_report(run, rows), encoding="utf-8")
+    write_csv(files["summary_csv"], [{k: ("" if isinstance(v, float) and math.isnan(v) else v)
+                                      for k, v in r.items()} for r in rows])
+    write_csv(files["episodes_csv"], [{k: ("" if v is None else v) for k, v in r.items()
+                                       if k != "trajectory"} for r in run.records])
+    return files
+
+
+def json_lines(records: Sequence[Mapping[str, Any]]) -> str:
+    """One JSON object per episode, one per line."""
+    return "".join(json.dumps(dict(r), allow_nan=False) + "\n" for r in records)

@@ -61,6 +61,17 @@ def test_line_of_sight_equals_segment_is_clear(g, xy, clear, res):
     assert got == want
 
 
+@settings(max_examples=300, deadline=None)
+@given(grids(), st.lists(st.integers(0, 20), min_size=4, max_size=4),
+       st.sampled_from([0.0, 1e-6, 0.5, 1.0]), st.sampled_from([1.0, 0.05, 0.1]))
+def test_line_of_sight_on_grid_aligned_segments(g, xy, clear, res):
+    # end points on cell corners and centres: segments along grid lines and through corners
+    occ = g[0]
+    ax, ay, bx, by = (v * 0.5 * res for v in xy)
+    want = segment_is_clear(ax, ay, bx, by, occ, 0.0, 0.0, res, clear * res)
+    assert line_of_sight(ax, ay, bx, by, occ, 0.0, 0.0, res, clear * res) == want
+
+
 def test_line_of_sight_on_long_segments():
     rng = np.random.default_rng(0)
     occ = rng.random((200, 300)) < 0.02

@@ -487,4 +487,14 @@ planners: [astar, thetastar, shortest]
     md = Path(files["markdown"]).read_text() if "markdown" in files else \
         (tmp_path / "rep" / "report.md").read_text()
     assert "excess over the shortest path" in md
+    # the command line prints it too
+    import subprocess
+    import sys
+
+    p = subprocess.run([sys.executable, "-m", "pathfuse.cli", "report", str(db), "--out",
+                        str(tmp_path / "rep2")], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert "excess over shortest" in p.stdout
+    line = next(ln for ln in p.stdout.splitlines() if ln.startswith("all") and " astar " in ln)
+    assert f"{100 * by['astar']['excess_mean']:+.2f}% (n=4)" in line
 

@@ -51,6 +51,7 @@ _EXPORTS: dict[str, str] = {
     "Episode": "pathfuse.world.episode",
     "World": "pathfuse.world.world",
     "load_scenario": "pathfuse.world.scenario",
+    "RobotModel": "pathfuse.robot",
 }
 
 __all__ = [
@@ -86,6 +87,7 @@ __all__ = [
     "Episode",
     "World",
     "load_scenario",
+    "RobotModel",
     "__version__",
 ]
 
@@ -138,6 +140,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and IDEs
         QueryError,
         Status,
     )
+    from pathfuse.robot import RobotModel
     from pathfuse.world.episode import Episode, simulate
     from pathfuse.world.scenario import load_scenario
     from pathfuse.world.world import World

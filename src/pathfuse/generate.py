@@ -47,6 +47,7 @@ from pathfuse.validate import short as _shown
 __all__ = [
     "paper_map",
     "random_map",
+    "shapes_map",
     "PAPER_START",
     "PAPER_GOAL",
     "PAPER_SIZE_M",
@@ -306,3 +307,55 @@ def paper_map(seed: int = 0) -> GridMap:
     )
     g.meta.update({"generator": "paper_map", "start": PAPER_START, "goal": PAPER_GOAL})
     return g
+
+
+def shapes_map(seed: int = 0, resolution: float = 0.1, size_m: Sequence[float] = (12.0, 12.0),
+               discs: int = 12, boxes: int = 6, radius_range_m: Sequence[float] = (0.3, 0.8),
+               box_side_range_m: Sequence[float] = (0.4, 1.6),
+               keep_free: Sequence[Sequence[float]] = ((1.0, 1.0), (11.0, 11.0)),
+               keep_free_radius_m: float = 1.2) -> GridMap:
+    """A map of random discs and axis-aligned boxes, drawn in continuous space, then
+    rasterised at ``resolution``: a cell is occupied when its centre lies inside a shape.
+
+    The shapes depend on ``seed`` only, not on the resolution, so the same world can be
+    rasterised at several resolutions (the resolution-independence study of the
+    potential-field repulsion).  No shape comes within ``keep_free_radius_m`` of the
+    ``keep_free`` points.  The origin is ``(0, 0)``.
+
+    >>> a, b = shapes_map(3, 0.1), shapes_map(3, 0.05)
+    >>> a.shape, b.shape, bool(abs(a.occupied.mean() - b.occupied.mean()) < 0.005)
+    ((120, 120), (240, 240), True)
+    """
+    rng = np.random.default_rng([int(seed), 7919])
+    w_m, h_m = (float(v) for v in size_m)
+    shapes: list[tuple[str, float, float, float, float]] = []
+    r_lo, r_hi = (float(v) for v in radius_range_m)
+    b_lo, b_hi = (float(v) for v in box_side_range_m)
+    free = np.asarray(keep_free, dtype=np.float64).reshape(-1, 2)
+    while len(shapes) < discs + boxes:
+        kind = "disc" if len(shapes) < discs else "box"
+        cx, cy = rng.uniform(0, w_m), rng.uniform(0, h_m)
+        if kind == "disc":
+            r = rng.uniform(r_lo, r_hi)
+            ext = r
+            shape = ("disc", cx, cy, r, r)
+        else:
+            hw, hh = rng.uniform(b_lo, b_hi) / 2, rng.uniform(b_lo, b_hi) / 2
+            ext = math.hypot(hw, hh)
+            shape = ("box", cx, cy, hw, hh)
+        if free.size and np.min(np.hypot(free[:, 0] - cx, free[:, 1] - cy)) < \
+                ext + keep_free_radius_m:
+            continue
+        shapes.append(shape)
+    nx, ny = _cells_of(w_m, resolution, "width"), _cells_of(h_m, resolution, "height")
+    xs = (np.arange(nx) + 0.5) * resolution
+    ys = (np.arange(ny) + 0.5) * resolution
+    X, Y = np.meshgrid(xs, ys)
+    occ = np.zeros((ny, nx), dtype=bool)
+    for kind, cx, cy, a, b in shapes:
+        if kind == "disc":
+            occ |= (X - cx) ** 2 + (Y - cy) ** 2 <= a * a
+        else:
+            occ |= (np.abs(X - cx) <= a) & (np.abs(Y - cy) <= b)
+    return GridMap(occ, resolution=resolution, origin=(0.0, 0.0),
+                   name=f"shapes-{seed}@{resolution:g}")

@@ -62,7 +62,8 @@ _MAX_PIECES = 1 << 14
 
 @njit(cache=True)
 def segment_static_distance(occ: np.ndarray, ox: float, oy: float, res: float, ax: float,
-                            ay: float, bx: float, by: float, cap: float) -> float:
+                            ay: float, bx: float, by: float, cap: float,
+                            edge_slack: float = 0.0) -> float:
     """Minimum distance from segment ``a-b`` to an occupied cell or the map's outside.
 
     Parameters
@@ -76,6 +77,11 @@ def segment_static_distance(occ: np.ndarray, ox: float, oy: float, res: float, a
     cap : float
         Search radius: the result is ``min(true distance, cap)``.  A collision
         check for a disc of radius ``r`` passes ``cap = r`` and tests ``< r``.
+    edge_slack : float
+        Added to the distance to the map's outside (not to the squares), for a
+        caller that keeps a margin from the squares but, like
+        :func:`pathfuse.geometry.segment_is_clear`, only the radius from the
+        edge (0 by default: the edge counts like a square).
 
     Returns
     -------
@@ -94,8 +100,9 @@ def segment_static_distance(occ: np.ndarray, ox: float, oy: float, res: float, a
         px = ax if i == 0 else bx
         py = ay if i == 0 else by
         de = min(px - xmin, xmax - px, py - ymin, ymax - py)
-        if de <= 0.0:
+        if de < 0.0 or (de == 0.0 and edge_slack == 0.0):
             return 0.0
+        de += edge_slack
         if de < best:
             best = de
     c0 = int(math.floor((min(ax, bx) - ox) / res))

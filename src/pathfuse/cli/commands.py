@@ -257,7 +257,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     else:
         choice = {"name": args.planner, "params": params}
     _warm_with_notice(str(choice["name"]), world=True)
-    ep = simulate(sc, planner=choice, seed=args.seed)
+    robot = None
+    if args.robot:
+        from dataclasses import asdict
+
+        robot = {**asdict(sc.robot), **_robot_block(args.robot)}
+    ep = simulate(sc, planner=choice, seed=args.seed, robot=robot)
     anim = None
     if out is not None:
         anim = animate_episode(ep, out, format=fmt, fps=args.fps, frame_step=args.frame_step)
@@ -308,7 +313,7 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
     cfg = DynamicConfig(
         n_seeds=args.seeds, moving=tuple(args.moving), speed_range=parse_speed(args.speed),
         planners=parse_planner_list(args.planners), seed=args.seed,
-        params=parse_planner_params(args.param),
+        params=parse_planner_params(args.param), robot=_robot_block(args.robot),
     )
     run = run_dynamic(cfg, progress=False if args.quiet else None, workers=args.workers,
                       db_path=_study_db(args.out))
@@ -330,6 +335,16 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
     return 0
 
+
+
+def _robot_block(items: Any) -> dict[str, Any]:
+    """``--robot KEY=VALUE`` items as a robot block (values read as YAML scalars)."""
+    from pathfuse.cli.args import parse_params
+
+    try:
+        return dict(parse_params(items))
+    except CliError as exc:
+        raise CliError(str(exc).replace("--param", "--robot")) from None
 
 
 def parse_seeds(text: str) -> int | str | list[int]:
@@ -430,14 +445,22 @@ def cmd_report(args: argparse.Namespace) -> int:
     n_exp, n_cfg = len({r["experimentid"] for r in study.runs}), len(study.config_ids())
     print(f"{args.db}: {len(study.runs)} runs, {n_exp} map entr{'y' if n_exp == 1 else 'ies'}, "
           f"{n_cfg} planner configuration{'' if n_cfg == 1 else 's'}")
-    head = ("scope", "configuration", "runs", "success", "errors", "length mean", "R_length")
+    excess = any(r.get("excess_pairs") for r in shown)
+    head: tuple[str, ...] = ("scope", "configuration", "runs", "success", "errors",
+                             "length mean", "R_length")
+    if excess:
+        head += ("excess over shortest",)
     table = [head]
     for r in shown:
         rl = "n/a" if not r["r_length_pairs"] else \
             f"{100 * r['r_length_mean']:+.2f}% (n={r['r_length_pairs']})"
         lm = "n/a" if not r["length_n"] else f"{r['length_mean_m']:.3f} m"
-        table.append((r["scope"], r["config"], str(r["runs"]),
-                      f"{100 * r['success_rate']:.1f}%", str(r["errors"]), lm, rl))
+        line: tuple[str, ...] = (r["scope"], r["config"], str(r["runs"]),
+                                 f"{100 * r['success_rate']:.1f}%", str(r["errors"]), lm, rl)
+        if excess:
+            line += ("-" if not r.get("excess_pairs") else
+                     f"{100 * r['excess_mean']:+.2f}% (n={r['excess_pairs']})",)
+        table.append(line)
     widths = [max(len(row[i]) for row in table) for i in range(len(head))]
     for row in table:
         print("  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())

@@ -158,6 +158,7 @@ examples:
 examples:
   pathfuse simulate examples/scenarios/head_on.yaml
   pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
+  pathfuse simulate examples/scenarios/corridor_crowd.yaml --planner dwa --robot model=diff-drive
   pathfuse simulate examples/scenarios/crossing.yaml --planner fusion --param repulsion=velocity
   pathfuse simulate examples/scenarios/random_walkers.yaml --seed 4 --json
   pathfuse simulate examples/scenarios/crossing.yaml --mp4 crossing.mp4 --fps 20 --frame-step 1
@@ -175,6 +176,9 @@ an animation plays in real time unless that takes more than 150 frames, then fas
                     help="planner parameter, repeatable (e.g. --param repulsion=velocity)")
     sm.add_argument("--seed", type=_nonneg_int, default=None,
                     help="episode seed for random walks (default: the scenario's)")
+    sm.add_argument("--robot", action="append", metavar="KEY=VALUE",
+                    help="override a key of the scenario's robot: block, repeatable (e.g. "
+                    "--robot model=diff-drive --robot clearance=0.1)")
     anim = sm.add_mutually_exclusive_group()
     anim.add_argument("--gif", metavar="OUT.gif", help="write an animated GIF")
     anim.add_argument("--mp4", metavar="OUT.mp4", help="write an MP4 video (needs ffmpeg)")
@@ -203,6 +207,7 @@ examples:
   pathfuse dynamic --seeds 50 --moving 0 2 4 8 --out dynamic-out
   pathfuse dynamic --seeds 100 --moving 0 4 8 12 --speed 0.5,1.0 --planners fusion,astar-replan
   pathfuse dynamic --seeds 200 --workers 2 --param fusion.repulsion=velocity --out velocity
+  pathfuse dynamic --seeds 200 --robot model=diff-drive --out dynamic-diff-drive
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -218,6 +223,10 @@ examples:
                     help="planner parameter, repeatable (e.g. --param fusion.swerve=0)")
     dy.add_argument("--seed", type=_nonneg_int, default=0,
                     help="master seed of the scenario family (default 0)")
+    dy.add_argument("--robot", action="append", metavar="KEY=VALUE",
+                    help="a key of the scenarios' robot: block, repeatable (e.g. --robot "
+                    "model=diff-drive --robot clearance=0.1; default: holonomic, radius 0.2 m, "
+                    "1 m/s)")
     dy.add_argument("--workers", type=_positive_int, default=None,
                     help="worker processes (default: every usable CPU; 1 = in this process)")
     dy.add_argument("--out", default="dynamic-out",

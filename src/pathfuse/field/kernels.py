@@ -50,13 +50,19 @@ import numpy as np
 from numba import njit
 
 from pathfuse.field.forces import att_force_xy
-from pathfuse.field.motion import HOW_BLOCKED, HOW_FULL, safe_step, straight_move
+from pathfuse.field.motion import (
+    HOW_BLOCKED,
+    HOW_FULL,
+    safe_step,
+    safe_step_margin,
+    straight_move,
+)
 from pathfuse.field.pathing import advance_progress, find_rejoin
 from pathfuse.field.repulsion import (
     disc_repulsion,
     fusion_force,
     grid_improved_repulsion,
-    grid_repulsion,
+    static_repulsion,
 )
 from pathfuse.geometry import segment_is_clear
 from pathfuse.result import Status
@@ -89,13 +95,18 @@ F_OY, F_RES, F_RADIUS, F_KMOV, F_RHOMOV, F_REACH, F_AMAX, F_SWERVE, F_RVX, F_RVY
 F_SUBTOL, F_NEXP, F_SCALE = 20, 21, 22
 # fusion_loop only
 F_R1, F_R2, F_BACKOFF = 20, 21, 22
-N_F = 23
+# both: the soft safety margin (ours; 0 = off)
+F_MARGIN = 23
+# both: the offset of the boundary repulsion (ours)
+F_OFFSET = 24
+N_F = 25
 # --- int settings
 I_STALLN, I_VELAWARE = 0, 1
 I_IMPROVED, I_TOGOAL = 2, 3  # field_loop
 I_AHEAD, I_ESCAPE, I_ESC_PTS, I_DRIVE = 2, 3, 4, 5  # fusion_loop
 I_SAFE, I_STALL = 6, 7  # both: safe step (ours) or the paper's full step; stall test (ours)
-N_I = 8
+I_BOUNDARY = 8  # both: 1 = the boundary repulsion (ours), 0 = the paper's per-cell sum
+N_I = 9
 # --- state
 S_SUB = 0  # field_loop: current sub-goal index
 # fusion_loop: progress index, mode (0 Algorithm 2, 1 escape along path points,
@@ -149,15 +160,17 @@ def _discs(x, y, fx, fy, f, i, dpos, dvel, drad):
 
 
 @njit(cache=True, inline="always")
-def _step(x, y, fx, fy, step, occ, ox, oy, res, clear, safe, radius):
-    """One move: the safe step (``safe``), or the paper's full step along the force.
+def _step(x, y, fx, fy, step, occ, ox, oy, res, clear, safe, radius, margin):
+    """One move: the safe step (``safe``; keeping the soft safety ``margin`` too, see
+    :func:`~pathfuse.field.motion.safe_step_margin`), or the paper's full step along the
+    force.
 
     Returns ``(nx, ny, how)``; for the full step ``how`` is ``HOW_BLOCKED`` for a
     zero force, ``HOW_FULL`` for a step touching nothing and ``-1`` for a step
     that touches an obstacle (closer than ``radius``; for a point any contact).
     """
     if safe:
-        return safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
+        return safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, margin)
     fn = math.hypot(fx, fy)
     if not (fn > 0.0) or not math.isfinite(fn):
         return x, y, HOW_BLOCKED
@@ -223,6 +236,8 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
     radius = f[F_RADIUS]
     improved = i[I_IMPROVED] == 1
     to_goal = i[I_TOGOAL] == 1
+    boundary = i[I_BOUNDARY] == 1
+    offset = f[F_OFFSET]
     last = subs.shape[0] - 1
     j = state[S_SUB]
     x = buf[n - 1, 0]
@@ -249,14 +264,15 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
             tx = gx if to_goal else sx
             ty = gy if to_goal else sy
             rx, ry = grid_improved_repulsion(x, y, tx, ty, occ, ox, oy, res, k_rep, rho0, nexp,
-                                             scale)
+                                             scale, boundary, offset)
         else:
-            rx, ry = grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0, rho0)
+            rx, ry = static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0, rho0, boundary,
+                                      offset)
         fx += rx
         fy += ry
         dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
         nx, ny, how = _step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear, safe,
-                            radius)
+                            radius, f[F_MARGIN])
         if how == HOW_BLOCKED:
             code = CODE_BLOCKED
             break
@@ -280,7 +296,8 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
 
 def pack_field(goal, k_att, k_rep, rho0_m, step_m, tol_m, clear_m, stall_steps,
                stall_distance_m, ox, oy, res, subgoal_tol_m, improved, to_goal, rep_exponent,
-               rep_scale_m, discs, safe_step=True, stall_exit=True):
+               rep_scale_m, discs, safe_step=True, stall_exit=True, margin_m=0.0,
+               boundary=False, offset_m=0.5):
     """Float and int settings of :func:`field_loop`; ``discs`` is :func:`disc_settings`."""
     f = np.zeros(N_F)
     f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
@@ -288,12 +305,15 @@ def pack_field(goal, k_att, k_rep, rho0_m, step_m, tol_m, clear_m, stall_steps,
     f[F_STEP], f[F_TOL], f[F_CLEAR], f[F_STALLD] = step_m, tol_m, clear_m, stall_distance_m
     f[F_OX], f[F_OY], f[F_RES] = ox, oy, res
     f[F_SUBTOL], f[F_NEXP], f[F_SCALE] = subgoal_tol_m, rep_exponent, rep_scale_m
+    f[F_MARGIN] = margin_m
+    f[F_OFFSET] = offset_m
     i = np.zeros(N_I, dtype=np.int64)
     i[I_STALLN] = stall_steps
     i[I_IMPROVED] = 1 if improved else 0
     i[I_TOGOAL] = 1 if to_goal else 0
     i[I_SAFE] = 1 if safe_step else 0
     i[I_STALL] = 1 if stall_exit else 0
+    i[I_BOUNDARY] = 1 if boundary else 0
     _put_discs(f, i, discs)
     return f, i
 
@@ -333,8 +353,11 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
             return nx, ny, True, landed
         return x, y, False, False
     pull = f[F_KATT] * f[F_R1] / d
-    nx, ny, how = safe_step(x, y, pull * (tx - x) + dfx, pull * (ty - y) + dfy, step, occ, ox,
-                            oy, res, clear)
+    fx = pull * (tx - x) + dfx
+    fy = pull * (ty - y) + dfy
+    nx, ny, how = safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, f[F_MARGIN])
+    if how == HOW_BLOCKED and f[F_MARGIN] > 0.0:  # the margin gives way to the escape
+        nx, ny, how = safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
     if how == HOW_BLOCKED:
         return x, y, False, False
     return nx, ny, True, math.hypot(tx - nx, ty - ny) <= 0.5 * step
@@ -389,6 +412,8 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
     safe = i[I_SAFE] == 1
     stall = i[I_STALL] == 1
     radius = f[F_RADIUS]
+    boundary = i[I_BOUNDARY] == 1
+    offset = f[F_OFFSET]
     m = pts.shape[0]
     k = state[S_K]
     mode = state[S_MODE]
@@ -425,10 +450,10 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
         if mode == 0:
             k = advance_progress(x, y, pts, cum, k, r1, occ, ox, oy, res, clear)
             fx, fy, _ = fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0,
-                                     r1, r2, occ, ox, oy, res)
+                                     r1, r2, occ, ox, oy, res, boundary, offset)
             dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
             nx, ny, how = _step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear, safe,
-                                radius)
+                                radius, f[F_MARGIN])
             if how == HOW_BLOCKED:
                 blocked = True
             else:
@@ -493,8 +518,12 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
             ri = -1
             rj = -1
             if escape == 1:
-                ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox, oy,
-                                     res, clear, kbuf, drive)
+                if f[F_MARGIN] > 0.0:  # a way back that keeps the safety margin first
+                    ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox,
+                                         oy, res, clear + f[F_MARGIN], kbuf, drive)
+                if ri < 0:
+                    ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox,
+                                         oy, res, clear, kbuf, drive)
             if ri < 0:
                 code = CODE_BLOCKED if blocked else CODE_STALLED
                 break
@@ -528,7 +557,8 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
 
 def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, stall_steps,
                 stall_distance_m, ox, oy, res, ahead, escape, escape_points, backoff_window_m,
-                drive, discs, safe_step=True, stall_exit=True):
+                drive, discs, safe_step=True, stall_exit=True, margin_m=0.0, boundary=False,
+                offset_m=0.5):
     """Float and int settings of :func:`fusion_loop` (``r2_m`` is the repulsion radius)."""
     f = np.zeros(N_F)
     f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
@@ -536,6 +566,8 @@ def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, 
     f[F_STEP], f[F_TOL], f[F_CLEAR], f[F_STALLD] = step_m, tol_m, clear_m, stall_distance_m
     f[F_OX], f[F_OY], f[F_RES] = ox, oy, res
     f[F_R1], f[F_R2], f[F_BACKOFF] = r1_m, r2_m, backoff_window_m
+    f[F_MARGIN] = margin_m
+    f[F_OFFSET] = offset_m
     i = np.zeros(N_I, dtype=np.int64)
     i[I_STALLN] = stall_steps
     i[I_AHEAD] = ahead
@@ -544,5 +576,6 @@ def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, 
     i[I_DRIVE] = 1 if drive else 0
     i[I_SAFE] = 1 if safe_step else 0
     i[I_STALL] = 1 if stall_exit else 0
+    i[I_BOUNDARY] = 1 if boundary else 0
     _put_discs(f, i, discs)
     return f, i

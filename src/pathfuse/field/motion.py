@@ -33,9 +33,11 @@ import math
 from numba import njit
 
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
+from pathfuse.sweep import segment_static_distance
 
 __all__ = [
     "MARGIN_FRAC",
+    "safe_step_margin",
     "HOW_BLOCKED",
     "HOW_FULL",
     "HOW_SLIDE",
@@ -104,3 +106,22 @@ def straight_move(x, y, tx, ty, step):
     if d <= step * (1.0 + 1e-9):
         return tx, ty, True
     return x + step * (tx - x) / d, y + step * (ty - y) / d, False
+
+
+@njit(cache=True)
+def safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, margin):
+    """:func:`safe_step` that keeps a soft safety ``margin`` beyond ``clear`` (ours).
+
+    With ``margin > 0`` the move keeps the clearance ``clear + min(margin,
+    gap)``, ``gap`` the robot's present gap beyond ``clear`` (exact), so a
+    robot outside the margin stays outside and a robot inside it never gets
+    closer; a move that cannot is blocked (the fusion then escapes along its
+    global path, whose moves keep only ``clear``, so a passage narrower than
+    the margin stays passable for it).  ``margin = 0`` is :func:`safe_step`
+    itself.
+    """
+    if margin <= 0.0:
+        return safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
+    d = segment_static_distance(occ, ox, oy, res, x, y, x, y, clear + margin)
+    hi = clear + min(margin, max(d - clear, 0.0)) * (1.0 - 1e-9)
+    return safe_step(x, y, fx, fy, step, occ, ox, oy, res, max(hi, clear))

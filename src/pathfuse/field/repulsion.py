@@ -16,6 +16,15 @@ cells of ``occ, ox, oy, res`` (see :mod:`pathfuse.geometry`).
 * :func:`disc_repulsion` - the repulsion of sensed moving discs (eq. 6 on
   the gap, or the velocity-aware form of Ge and Cui 2002), with the
   tangential ``swerve`` of pathfuse.
+* :func:`boundary_repulsion` - ours, the resolution-independent option
+  (``static_repulsion="boundary"``): eq. 6 once, on the exact distance ``d``
+  from the robot's centre to the nearest point of an occupied square, plus
+  ``offset`` (:data:`BOUNDARY_OFFSET_M`, half the paper's 1 m cell), along
+  the direction away from that point.  The same obstacle gives the same
+  force however finely it is rasterised; at the paper's 1 m cells an
+  isolated obstacle cell pushes exactly as in the paper along its faces'
+  normals (its centre lies half a cell behind the face).  The per-cell sum
+  (``"cells"``) stays the default: it is the paper's model and its numbers.
 
 Examples
 --------
@@ -36,6 +45,11 @@ from numba import njit
 from pathfuse.field.forces import D_MIN_M, att_force_xy, rep_force_xy, rep_potential_d
 
 __all__ = [
+    "BOUNDARY_OFFSET_M",
+    "nearest_obstacle_point",
+    "boundary_repulsion",
+    "boundary_potential",
+    "static_repulsion",
     "AHEAD_PROGRESS",
     "AHEAD_PAPER_X",
     "GAP_MIN_M",
@@ -51,6 +65,9 @@ __all__ = [
 # "ahead" rules of the fusion planner
 AHEAD_PROGRESS = 0
 AHEAD_PAPER_X = 1
+
+BOUNDARY_OFFSET_M = 0.5
+"""Default offset of the boundary repulsion: half the paper's 1 m cell (metres)."""
 
 GAP_MIN_M = 1e-3
 """Gaps below this (metres) are clamped in the moving-disc repulsion."""
@@ -104,16 +121,104 @@ def grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m):
 
 
 @njit(cache=True)
-def apf_force(x, y, gx, gy, k_att, k_rep, rho0_m, radius_m, occ, ox, oy, res):
+def nearest_obstacle_point(x, y, occ, ox, oy, res, cap):
+    """The nearest point of an occupied square to ``(x, y)`` within ``cap`` metres (exact).
+
+    Returns ``(d, px, py)``; ``d = cap`` and the point ``(x, y)`` when none is
+    closer.  Squares are visited ring by ring outwards from the robot's cell,
+    and the search stops once a ring lies beyond the best distance or ``cap``.
+    """
+    h, w = occ.shape
+    c0 = int(math.floor((x - ox) / res))
+    r0 = int(math.floor((y - oy) / res))
+    best = cap
+    bx = x
+    by = y
+    k = 0
+    kmax = int(math.ceil(cap / res)) + 1
+    while k <= kmax:
+        if k >= 1 and (k - 1) * res >= best:
+            break
+        for rr in range(r0 - k, r0 + k + 1):
+            if rr < 0 or rr >= h:
+                continue
+            edge = rr == r0 - k or rr == r0 + k
+            step = 1 if (edge or k == 0) else 2 * k
+            cc = c0 - k
+            while cc <= c0 + k:
+                if 0 <= cc < w and occ[rr, cc]:
+                    x0 = ox + cc * res
+                    y0 = oy + rr * res
+                    px = min(max(x, x0), x0 + res)
+                    py = min(max(y, y0), y0 + res)
+                    d = math.sqrt((x - px) * (x - px) + (y - py) * (y - py))
+                    if d < best:
+                        best = d
+                        bx = px
+                        by = py
+                cc += step
+        k += 1
+    return best, bx, by
+
+
+@njit(cache=True)
+def boundary_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, offset_m):
+    """Eq. 6 on ``d + offset_m``, ``d`` the exact distance to the nearest occupied square,
+    within ``min(radius_m, rho0_m)``; away from the nearest point (ours, see the module
+    docstring).  Inside a square (``d = 0``) it pushes away from the square's centre."""
+    lim = radius_m if radius_m < rho0_m else rho0_m
+    if lim <= offset_m:
+        return 0.0, 0.0
+    d, px, py = nearest_obstacle_point(x, y, occ, ox, oy, res, lim - offset_m)
+    deff = d + offset_m
+    if deff >= lim:
+        return 0.0, 0.0
+    if d > 0.0:
+        ux = (x - px) / d
+        uy = (y - py) / d
+    else:
+        cx = ox + (math.floor((x - ox) / res) + 0.5) * res
+        cy = oy + (math.floor((y - oy) / res) + 0.5) * res
+        n = math.hypot(x - cx, y - cy)
+        if n == 0.0:
+            return 0.0, 0.0
+        ux = (x - cx) / n
+        uy = (y - cy) / n
+    dc = deff if deff > D_MIN_M else D_MIN_M
+    m = k_rep * (1.0 / dc - 1.0 / rho0_m) / (dc * dc)
+    return m * ux, m * uy
+
+
+@njit(cache=True)
+def boundary_potential(x, y, occ, ox, oy, res, k_rep, rho0_m, offset_m):
+    """Eq. 4 on ``d + offset_m`` (the potential of :func:`boundary_repulsion`)."""
+    if rho0_m <= offset_m:
+        return 0.0
+    d, _, _ = nearest_obstacle_point(x, y, occ, ox, oy, res, rho0_m - offset_m)
+    return rep_potential_d(d + offset_m, k_rep, rho0_m) if d + offset_m < rho0_m else 0.0
+
+
+@njit(cache=True, inline="always")
+def static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, boundary, offset_m):
+    """The static map's repulsion: the paper's per-cell sum, or the boundary form."""
+    if boundary:
+        return boundary_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, offset_m)
+    return grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m)
+
+
+@njit(cache=True)
+def apf_force(x, y, gx, gy, k_att, k_rep, rho0_m, radius_m, occ, ox, oy, res, boundary=False,
+              offset_m=BOUNDARY_OFFSET_M):
     """Resultant force of the plain APF at ``(x, y)``: eq. 5 to the goal plus eq. 6."""
     fx, fy = att_force_xy(x, y, gx, gy, k_att)
-    rx, ry = grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m)
+    rx, ry = static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, boundary,
+                              offset_m)
     return fx + rx, fy + ry
 
 
 @njit(cache=True)
 def fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0_m, r1_m, r2_m,
-                 occ, ox, oy, res):
+                 occ, ox, oy, res, boundary=False, offset_m=BOUNDARY_OFFSET_M):
     """Resultant force of Algorithm 2 at ``(x, y)``.
 
     Attraction (eq. 5) of the goal plus of every path point ``pts[j]``
@@ -156,7 +261,7 @@ def fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0_m, r1_m, r
                 fy -= k_att * dy
                 na += 1
             j += 1
-    rx, ry = grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, r2_m)
+    rx, ry = static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, r2_m, boundary, offset_m)
     return fx + rx, fy + ry, na
 
 
@@ -185,7 +290,8 @@ def grid_rep_potential(x, y, occ, ox, oy, res, k_rep, rho0_m):
 
 
 @njit(cache=True)
-def grid_improved_repulsion(x, y, tx, ty, occ, ox, oy, res, k_rep, rho0_m, n, scale_m):
+def grid_improved_repulsion(x, y, tx, ty, occ, ox, oy, res, k_rep, rho0_m, n, scale_m,
+                            boundary=False, offset_m=BOUNDARY_OFFSET_M):
     """The Ge-Cui repulsion at ``(x, y)`` for the target ``(tx, ty)`` on a grid.
 
     ``(rho_g/L)^n`` times :func:`grid_repulsion` plus ``n U (rho_g/L)^(n-1) /
@@ -199,10 +305,14 @@ def grid_improved_repulsion(x, y, tx, ty, occ, ox, oy, res, k_rep, rho0_m, n, sc
         return 0.0, 0.0
     q = rg / scale_m
     s = q**n
-    fx, fy = grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, rho0_m)
+    fx, fy = static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, rho0_m, boundary,
+                              offset_m)
     fx *= s
     fy *= s
-    u = grid_rep_potential(x, y, occ, ox, oy, res, k_rep, rho0_m)
+    if boundary:
+        u = boundary_potential(x, y, occ, ox, oy, res, k_rep, rho0_m, offset_m)
+    else:
+        u = grid_rep_potential(x, y, occ, ox, oy, res, k_rep, rho0_m)
     if u > 0.0:
         m = u * n * q ** (n - 1.0) / scale_m / rg
         fx += m * dgx

@@ -25,7 +25,8 @@ expansions.
     The shortest path among the occupied squares
     (:mod:`pathfuse.search.visibility`, where its exact definition is): for a
     point robot the physical limit of path length, within ``1.5e-6`` cells per
-    corner, and a lower bound of every pathfuse planner's length; for a disc
+    obstacle point it touches, and a lower bound of the length of every pathfuse
+    planner that keeps pathfuse's margin (all, by default); for a disc
     robot the shortest path of the square robot that holds the disc.
 
 Examples

@@ -74,7 +74,8 @@ class SubgoalController(FieldController):
             problem.goal, p.k_att, p.k_rep, p.rho0_m, self.step_m, self.goal_tolerance_m,
             self.clear_m, p.stall_steps, self.stall_distance_m, ox, oy, g.resolution,
             self.subgoal_tolerance(), self.improved, self.rep_to_goal(), self.rep_exponent(),
-            self.rep_scale(), self.disc_settings(), p.safe_step, p.stall_exit)
+            self.rep_scale(), self.disc_settings(), p.safe_step, p.stall_exit,
+            problem.clearance_m, p.static_repulsion == "boundary", p.boundary_offset_m)
         self.state = np.zeros(1, dtype=np.int64)
 
     def make_subgoals(self) -> np.ndarray:
@@ -147,7 +148,8 @@ def force_at(grid: GridMap, xy: object, goal: object, params: APFParams | None =
     out = np.empty_like(pts)
     for k in range(pts.shape[0]):
         out[k] = apf_force(pts[k, 0], pts[k, 1], gx, gy, p.k_att, p.k_rep, p.rho0_m, p.rho0_m,
-                           grid.occupied, ox, oy, grid.resolution)
+                           grid.occupied, ox, oy, grid.resolution,
+                           p.static_repulsion == "boundary", p.boundary_offset_m)
     return out[0] if np.ndim(cast("ArrayLike", xy)) == 1 else out
 
 

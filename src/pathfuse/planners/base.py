@@ -33,6 +33,7 @@ from pathfuse.field.kernels import (
     CODE_GOAL_SNAP,
     CODE_RUNNING,
     CODE_STALLED,
+    F_CLEAR,
     F_RVX,
     F_RVY,
     code_status,
@@ -321,7 +322,10 @@ class FieldController(Controller):
             discs = _NO_DISCS
         self.f[F_RVX] = float(obs.velocity[0])
         self.f[F_RVY] = float(obs.velocity[1])
+        tight = self._tight(x, y)
         code, _ = self._call(1, *discs)
+        if tight:
+            self.f[F_CLEAR] = self.clear_m
         if code in (CODE_STALLED, CODE_BLOCKED):
             self.on_stuck()
         if self.n > n0:
@@ -335,6 +339,23 @@ class FieldController(Controller):
                 nx, ny = d
         dt = float(self.dt)  # type: ignore[arg-type]
         return np.array([(nx - x) / dt, (ny - y) / dt])
+
+    def _tight(self, x: float, y: float) -> bool:
+        """Online, a robot that the world left closer to a wall than the controller's
+        clearance (a diff-drive robot braking late) may keep what it has for this move;
+        True when the clearance was lowered for it."""
+        rb = self.problem.robot
+        if rb is None or not rb.is_diff_drive:
+            return False
+        from pathfuse.sweep import segment_static_distance
+
+        g = self.problem.grid
+        d = segment_static_distance(g.occupied, float(g.origin[0]), float(g.origin[1]),
+                                    float(g.resolution), x, y, x, y, self.clear_m)
+        if d >= self.clear_m:
+            return False
+        self.f[F_CLEAR] = d * (1.0 - 1e-12)
+        return True
 
     def on_stuck(self) -> None:
         """Online: the loop stalled or was blocked and could not escape; keep going."""
@@ -360,6 +381,14 @@ class FieldController(Controller):
 
         best = gap(x, y)
         best_xy = None
+        clear = self.clear_m
+        margin = self.problem.clearance_m
+        if margin > 0:  # keep the safety margin, or what is left of it (ours)
+            from pathfuse.sweep import segment_static_distance
+
+            d = segment_static_distance(g.occupied, float(ox), float(oy), g.resolution, x, y,
+                                        x, y, clear + margin)
+            clear = max(clear, clear + min(margin, max(d - clear, 0.0)) * (1.0 - 1e-9))
         if fx == 0.0 and fy == 0.0:
             gx, gy = self.problem.goal
             fx, fy = gx - x, gy - y
@@ -367,7 +396,7 @@ class FieldController(Controller):
         for k in range(12):
             a = a0 + math.pi / 6 * ((k + 1) // 2) * (1 if k % 2 else -1)
             tx, ty = x + step * math.cos(a), y + step * math.sin(a)
-            if segment_is_clear(x, y, tx, ty, g.occupied, ox, oy, g.resolution, self.clear_m):
+            if segment_is_clear(x, y, tx, ty, g.occupied, ox, oy, g.resolution, clear):
                 gp = gap(tx, ty)
                 if gp > best + 1e-9:
                     best, best_xy = gp, (tx, ty)

@@ -26,6 +26,10 @@ as it is.  A diff-drive robot gets ``(v, omega)`` from
    if none passes, the same with the yaw rates of the window nearest the
    desired one (the last one, 0, either extreme).  If nothing passes, the
    lowest speed with the desired yaw rate is taken (the world judges it).
+   With a safety margin (``clearance_m``, ours) all this is first tried
+   keeping ``radius + min(margin, present gap)`` clear, then with the
+   radius alone.  A robot already closer than that (it braked too late) may
+   keep its present clearance: moves that do not reduce it pass.
 
 So a robot that can brake in time never drives into a wall because of the
 conversion, turning on the spot is always allowed (the footprint is a
@@ -86,7 +90,7 @@ def admissible(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: f
 def unicycle_command(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
                      th: float, v0: float, w0: float, ux: float, uy: float, dt: float,
                      vmin: float, vmax: float, amax: float, wmax: float, alpha: float,
-                     clear: float) -> tuple[float, float]:
+                     clear: float, margin: float = 0.0) -> tuple[float, float]:
     """``(v, omega)`` for the desired velocity ``(ux, uy)`` (see the module docstring)."""
     s = math.sqrt(ux * ux + uy * uy)
     v_des = 0.0
@@ -106,6 +110,25 @@ def unicycle_command(occ: np.ndarray, ox: float, oy: float, res: float, x: float
     vlo = max(vmin, v0 - amax * dt)
     vhi = min(vmax, v0 + amax * dt)
     v = min(max(v_des, vlo), vhi)
+    # a robot that came closer than ``clear`` (braking too late) may keep what it has
+    d = segment_static_distance(occ, ox, oy, res, x, y, x, y, clear + margin + 1.0)
+    if d < clear:
+        clear = d * (1.0 - 1e-12)
+    # with a safety margin: first keep it (or what is left of it), then only the radius
+    hi = clear
+    if margin > 0.0:
+        hi = max(clear, clear + min(margin, max(d - clear, 0.0)) * (1.0 - 1e-9))
+    for pas in range(2 if hi > clear else 1):
+        cl = hi if pas == 0 else clear
+        vk, wj, ok = _first_admissible(occ, ox, oy, res, x, y, th, v, vlo, w, w0, wlo, whi,
+                                       dt, amax, cl)
+        if ok:
+            return vk, wj
+    return vlo, w
+
+
+@njit(cache=True)
+def _first_admissible(occ, ox, oy, res, x, y, th, v, vlo, w, w0, wlo, whi, dt, amax, clear):
     # the desired yaw rate first; if no speed is admissible with it, the yaw rates of the
     # window nearest to it (keep turning, go straight, turn hard either way)
     for j in range(5):
@@ -125,8 +148,8 @@ def unicycle_command(occ: np.ndarray, ox: float, oy: float, res: float, x: float
             if vk > 0.0 and math.isfinite(amax):
                 brake = vk * vk / (2.0 * amax)
             if admissible(occ, ox, oy, res, x, y, th, vk, wj, dt, brake, clear):
-                return vk, wj
-    return vlo, w
+                return vk, wj, True
+    return vlo, w, False
 
 
 def to_unicycle(problem: Any, robot: Any, dt: float, obs: Any, u: Any) -> np.ndarray:
@@ -141,7 +164,8 @@ def to_unicycle(problem: Any, robot: Any, dt: float, obs: Any, u: Any) -> np.nda
         float(u[0]), float(u[1]), float(dt), float(robot.min_speed_mps),
         float(robot.max_speed_mps), float(robot.max_accel_mps2),
         float(robot.max_yaw_rate_radps), float(robot.max_yaw_accel_radps2),
-        float(problem.robot_radius_m) + MARGIN_FRAC * float(g.resolution))
+        float(problem.robot_radius_m) + MARGIN_FRAC * float(g.resolution),
+        float(problem.clearance_m))
     return np.array([v, w])
 
 

@@ -38,8 +38,11 @@ The least-cost admissible sample is commanded.  With none, the robot slows
 as hard as it can and turns towards the path ahead.  The robot's progress
 along the path only moves forward, to path points in sight
 (:func:`~pathfuse.field.pathing.advance_progress`), and the global path is
-replanned from the robot's position on the static map every
-``replan_period_s`` (1 s, as Nav2's default behaviour tree does).  Online
+replanned from the robot's position every ``replan_period_s`` (1 s, as
+Nav2's default behaviour tree does), with the sensed discs as blocked
+cells (grown by the robot's radius, as Nav2's obstacle layer puts what the
+sensors see into the global costmap; the static path when they box the
+robot in).  Online
 (:func:`pathfuse.simulate`) this runs once per tick with the robot's model;
 offline (:func:`pathfuse.plan`) the controller drives a simulated robot on
 the static map, by default a diff-drive one
@@ -94,7 +97,7 @@ class DWAParams(GlobalAStarParams):
     v_samples: int = param(7, ge=2, help="linear speeds sampled in the window (holonomic: "
                                          "speeds from 0 to the limit)")
     w_samples: int = param(15, ge=3, help="yaw rates sampled in the window (holonomic: "
-                                          "directions)")
+                                          "3 x this many directions)")
     horizon_s: float = param(2.5, gt=0, unit="s", help="how long each sample is rolled out")
     sim_step_s: float = param(0.1, gt=0, unit="s", help="length of a rollout piece")
     dt_s: float = param(0.1, gt=0, unit="s",
@@ -111,16 +114,16 @@ class DWAParams(GlobalAStarParams):
                                     help="static gaps beyond this cost nothing")
     inflation_decay_m: float = param(0.1, gt=0, unit="m",
                                      help="the obstacle cost exp(-gap / decay)")
-    lookahead_m: float = param(1.5, gt=0, unit="m",
+    lookahead_m: float = param(0.5, gt=0, unit="m",
                                help="heading critic: aim at the path this far beyond the "
                                     "rollout end's projection")
     goal_tolerance_m: float = param(0.25, gt=0, unit="m",
                                     help="offline: within this a clear straight move onto "
                                          "the goal ends the path")
     replan_period_s: float = param(1.0, ge=0, unit="s",
-                                   help="replan the global A* path from the robot's position "
-                                        "on the static map this often (Nav2's default 1 Hz; "
-                                        "0 = never)")
+                                   help="replan the global A* path from the robot's position, "
+                                        "around the sensed discs, this often (Nav2's default "
+                                        "1 Hz; 0 = never)")
     stall_steps: int = param(50, ge=1, help="offline: look-back of the stall test, in ticks")
     stall_distance_m: float = param(0.05, gt=0, unit="m",
                                     help="offline: a net move below this over stall_steps "
@@ -166,6 +169,7 @@ class DWAController(Controller):
             p.lookahead_m, p.inflation_decay_m, not rb.is_diff_drive, ox, oy, g.resolution)
         self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
         self.no_choice = 0
+        self._sensed = _NO_DISCS
 
     def _set_path(self, pts: np.ndarray) -> None:
         gx, gy = self.problem.goal
@@ -178,7 +182,21 @@ class DWAController(Controller):
     def _replan(self, x: float, y: float) -> None:
         from pathfuse.planners.global_astar import plan_global
 
-        gp = plan_global(self.problem.with_start((x, y)), self.params.heuristic)
+        pb = self.problem
+        occ = None
+        dpos, _, drad = self._sensed
+        if drad.shape[0]:
+            # the sensed discs as blocked cells, as Nav2's obstacle layer puts what the
+            # sensors see into the global costmap
+            from pathfuse.planners.astar import _rasterise_discs
+
+            g = pb.grid
+            occ = g.cspace(pb.robot_radius_m).occupied.copy()
+            _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
+                             dpos, drad, float(pb.robot_radius_m))
+        gp = plan_global(pb.with_start((x, y)), self.params.heuristic, occupied=occ)
+        if not gp.success and occ is not None:  # boxed in by the discs: the static path
+            gp = plan_global(pb.with_start((x, y)), self.params.heuristic)
         self.replans += 1
         if gp.success:
             self._set_path(np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2))
@@ -209,6 +227,7 @@ class DWAController(Controller):
             drad = np.require(sens.radii, np.float64, ("C", "W"))
         else:
             dpos, dvel, drad = _NO_DISCS
+        self._sensed = (dpos, dvel, drad)
         cmd = obs.command
         a0, a1 = self._choose(float(obs.position[0]), float(obs.position[1]),
                               float(obs.heading), float(cmd[0]), float(cmd[1]), dpos, dvel,

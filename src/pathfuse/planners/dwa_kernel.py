@@ -13,6 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
+from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.sweep import (
     arc_deviation_bound,
     disc_sweep_gaps,
@@ -26,6 +27,7 @@ __all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "N_D"]
  D_SIMDT, D_NV, D_NW, D_WPATH, D_WGOAL, D_WHEAD, D_WSPEED, D_WOBS, D_WDYN, D_RANGE,
  D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES) = range(26)
 N_D = 26
+SOFT = 0.3
 
 
 def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
@@ -102,6 +104,8 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
     dt = f[D_DT]
     clear = f[D_CLEAR]
     radius = f[D_RADIUS]
+    # the edge rule of segment_is_clear: pathfuse's margin is kept from squares, not the edge
+    slack = MARGIN_FRAC * res
     horizon = f[D_HORIZON]
     h = f[D_SIMDT]
     rng = f[D_RANGE]
@@ -136,7 +140,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
     for i in range(1, n + 1):
         t = min(i * h, horizon)
         bx, by, bth = unicycle_pose(x, y, th, v, w, t)
-        d = segment_static_distance(occ, ox, oy, res, ax, ay, bx, by, cap) - e
+        d = segment_static_distance(occ, ox, oy, res, ax, ay, bx, by, cap, slack) - e
         if t <= dt + 1e-12:
             # the tick itself: the arc (lower bound) and the chord (the path offline) clear
             if d < clear:
@@ -144,7 +148,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
                 ok = False
                 break
             if e > 0.0 and segment_static_distance(occ, ox, oy, res, ax, ay, bx, by,
-                                                   clear) < clear:
+                                                   clear, slack) < clear:
                 first_ok = False
                 ok = False
                 break
@@ -192,7 +196,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
             # standing in the disc's way), and how soon it starts
             dyn = 1.5 + 2.0 * min(-gmin / (radius + dmaxr), 1.0) + 0.5 * (horizon - tc) / horizon
         elif gmin < np.inf:
-            dyn = math.exp(-max(gmin, 0.0) / 0.25)
+            dyn = SOFT * math.exp(-max(gmin, 0.0) / 0.2)
     # the end point against the path near the progress index: its distance to the path and
     # how much path is left beyond its projection
     m = pts.shape[0]
@@ -249,8 +253,31 @@ def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     ``(c0, c1)`` is the last command: ``(v, omega)`` for a diff-drive robot,
     ``(vx, vy)`` for a holonomic one.  Returns ``(a0, a1, admissible_count,
     cost)`` with ``(a0, a1)`` in the same terms; with no admissible sample, the
-    slowest command of the window turning towards the local goal.
+    slowest command of the window turning towards the local goal.  With a
+    safety margin the samples are first held to keeping ``clear + min(margin,
+    max(present gap, margin / 2))`` (admissibility as above with that
+    clearance; a robot already deeper inside gets none passing); only when
+    none passes, to ``clear``.
     """
+    margin = f[D_MARGIN]
+    if margin > 0.0:
+        clear = f[D_CLEAR]
+        d = segment_static_distance(occ, f[D_OX], f[D_OY], f[D_RES], x, y, x, y,
+                                    clear + margin, MARGIN_FRAC * f[D_RES])
+        # keep the margin, or at least half of it where the robot still has that much
+        hi = clear + min(margin, max(d - clear, 0.5 * margin)) * (1.0 - 1e-9)
+        if hi > clear:
+            f2 = f.copy()
+            f2[D_CLEAR] = hi
+            a0, a1, count, best = _choose(occ, f2, x, y, th, c0, c1, pts, cum, k, dpos, dvel,
+                                          drad)
+            if count > 0:
+                return a0, a1, count, best
+    return _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad)
+
+
+@njit(cache=True)
+def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     dt = f[D_DT]
     vmax = f[D_VMAX]
     amax = f[D_AMAX]
@@ -263,12 +290,14 @@ def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     b1 = 0.0
     count = 0
     if f[D_HOLO] == 1.0:
-        # velocity vectors: speeds x directions, within |u - u0| <= a dt
+        # velocity vectors: speeds x directions (3 w_samples of them, every 8 degrees by
+        # default), within |u - u0| <= a dt
         lim = amax * dt
+        ndir = 3 * nw
         for i in range(nv):
             s = vmax * i / (nv - 1)
-            for j in range(nw if i > 0 else 1):
-                a = 2.0 * math.pi * j / nw
+            for j in range(ndir if i > 0 else 1):
+                a = 2.0 * math.pi * j / ndir
                 ux = s * math.cos(a)
                 uy = s * math.sin(a)
                 if math.isfinite(lim):

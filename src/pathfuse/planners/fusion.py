@@ -145,7 +145,8 @@ class FusionController(FieldController):
             problem.goal, p.k_att, p.k_rep, p.rho0_m, p.r1_m, p.r2_m, self.step_m,
             self.goal_tolerance_m, self.clear_m, p.stall_steps, self.stall_distance_m, ox, oy,
             g.resolution, _AHEAD[p.ahead], p.escape, p.escape_points, window, self.online,
-            self.disc_settings(), p.safe_step, p.stall_exit)
+            self.disc_settings(), p.safe_step, p.stall_exit,
+            problem.clearance_m, p.static_repulsion == "boundary", p.boundary_offset_m)
         self.state = np.zeros(N_S, dtype=np.int64)
         self.kbuf = np.zeros(self.buf.shape[0], dtype=np.int64)
 
@@ -233,7 +234,8 @@ def force_at(grid: GridMap, xy: object, goal: object, global_path: object,
     ox, oy = grid.origin
     fx, fy, _ = fusion_force(x, y, gx, gy, pts, polyline_cumlen(pts), int(progress),
                              _AHEAD[p.ahead], p.k_att, p.k_rep, p.rho0_m, p.r1_m, p.r2_m,
-                             grid.occupied, ox, oy, grid.resolution)
+                             grid.occupied, ox, oy, grid.resolution,
+                             p.static_repulsion == "boundary", p.boundary_offset_m)
     return np.array([fx, fy])
 
 

@@ -10,6 +10,9 @@ map's edge grown by the radius; the map itself for a point robot).
 * :attr:`GlobalPlan.points` are the cell centres from the start cell to the
   goal cell: the grid path, whose length is the A* cost
   (:attr:`GlobalPlan.length_m`).  This is what the ``astar`` planner returns.
+* With a safety margin (``problem.clearance_m > 0``, ours) the search pays
+  a clearance cost near obstacles (:mod:`pathfuse.search.costaware`);
+  ``length_m`` is then the path's length, not its cost.
 * :attr:`GlobalPlan.waypoints` are what a controller follows:
   ``[start, centres..., goal]``, the first and last centres left out when
   the straight move past them is clear (on a query between cell centres the
@@ -167,11 +170,14 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
                               heuristic=heuristic, corner_cutting=corner_cutting)
     else:
         sc, gc = problem.start_cell, problem.goal_cell
+    budget = problem.budget
+    if problem.clearance_m > 0:
+        return _plan_with_margin(problem, occ, sc, gc, heuristic, corner_cutting,
+                                 max_expansions)
     if occupied is None:
         searcher = get_searcher(cs, corner_cutting=corner_cutting)
     else:
         searcher = AStarSearcher(occ, corner_cutting=corner_cutting)
-    budget = problem.budget
     limit = budget.time_limit_s if time_limit_s is None else time_limit_s
     t0 = time.perf_counter()
     # the cells are in bounds and free (the problem and the snapping checked them)
@@ -195,6 +201,46 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
                       res.cost * grid.resolution, res.expansions, elapsed,
                       f"path through {len(res.cells)} cells, {res.cost * grid.resolution:.6g} m, "
                       f"{res.expansions} expansions", heuristic, corner_cutting)
+
+
+_WARM_COST: list[bool] = []
+
+
+def _plan_with_margin(problem: Problem, occ: np.ndarray, sc: tuple[int, int],
+                      gc: tuple[int, int], heuristic: str, corner_cutting: bool,
+                      max_expansions: int | None) -> GlobalPlan:
+    """A* with the clearance cost of :mod:`pathfuse.search.costaware` (a margin is set)."""
+    from pathfuse.search.costaware import (
+        clearance_multipliers,
+        costaware_search,
+        warmup_costaware,
+    )
+
+    if not _WARM_COST:
+        warmup_costaware()  # compilation stays out of time_s
+        _WARM_COST.append(True)
+    grid = problem.grid
+    mult = clearance_multipliers(grid, problem.robot_radius_m, problem.clearance_m)
+    t0 = time.perf_counter()
+    code, cells, cost, exp = costaware_search(occ, mult, sc, gc, corner_cutting,
+                                              max_expansions)
+    elapsed = time.perf_counter() - t0
+    if code == 1:
+        return GlobalPlan(Status.NO_PATH, expansions=exp, time_s=elapsed,
+                          message=f"goal is not reachable from start ({exp} expansions)",
+                          heuristic=heuristic, corner_cutting=corner_cutting)
+    if code == 2:
+        return GlobalPlan(Status.MAX_ITERATIONS, expansions=exp, time_s=elapsed,
+                          message=f"stopped after {exp} expansions (max_iterations)",
+                          heuristic=heuristic, corner_cutting=corner_cutting)
+    res = grid.resolution
+    pts = np.column_stack([grid.origin[0] + (cells[:, 1] + 0.5) * res,
+                           grid.origin[1] + (cells[:, 0] + 0.5) * res])
+    length = float(np.hypot(*np.diff(pts, axis=0).T).sum()) if len(pts) > 1 else 0.0
+    return GlobalPlan(Status.SUCCESS, cells, pts, problem, length, exp, elapsed,
+                      f"path through {len(cells)} cells, {length:.6g} m, keeping a "
+                      f"{problem.clearance_m:g} m margin where it can (cost {cost * res:.6g}), "
+                      f"{exp} expansions", heuristic, corner_cutting)
 
 
 def _waypoints(problem: Problem, centres: np.ndarray) -> np.ndarray:

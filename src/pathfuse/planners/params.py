@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pathfuse.field.forces import K_ATT, K_REP, RHO0_M
+from pathfuse.field.repulsion import BOUNDARY_OFFSET_M
 from pathfuse.search.astar import HEURISTICS
 from pathfuse.validate import check_fields, param
 
@@ -63,6 +64,16 @@ class FieldParams(Checked):
                                         "stall_steps moves is below stall_distance_m (ours); "
                                         "false = the paper's loop, which stops only at the goal "
                                         "or the move cap")
+    static_repulsion: str = param(
+        "cells", choices=("cells", "boundary"),
+        help="the static map's repulsion: 'cells' = eq. 6 summed over every occupied cell "
+             "centre within rho0_m (the paper; it grows as the cells shrink); 'boundary' = "
+             "eq. 6 once, on the exact distance to the nearest occupied square plus "
+             "boundary_offset_m (ours; the same at any resolution)")
+    boundary_offset_m: float = param(
+        BOUNDARY_OFFSET_M, gt=0, unit="m",
+        help="added to the distance of the boundary repulsion (default: half the paper's "
+             "1 m cell, so an isolated paper cell pushes as in the paper)")
 
 
 @dataclass(frozen=True)

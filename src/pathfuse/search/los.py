@@ -9,9 +9,9 @@ It differs only in which cells it visits: ``segment_is_clear`` scans the
 segment's whole bounding box, which is fine for a robot's short moves but
 costs ``O(length^2)`` cells on the long sight lines of Theta*;
 :func:`line_of_sight` scans a strip along the segment, column by column (or
-row by row for a steep segment), ``O(length)`` cells.  The strip is padded
-by one cell, so it always covers every square within ``clear`` of the
-segment; the per-cell test decides.
+row by row for a steep segment), ``O(length)`` cells.  The strip reaches
+``1e-7`` cell beyond ``clear``, so the rounding of its bounds never leaves out
+a square within ``clear`` of the segment; the per-cell test decides.
 
 :func:`smooth_path` is the post-smoothing of A* PS (Nash et al. 2007): from
 each kept point, skip ahead while the next point after is in sight.
@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numba import njit
 
-from pathfuse.geometry import _segment_hits_box, segment_box_distance
+from pathfuse.geometry import MARGIN_FRAC, _segment_hits_box, segment_box_distance
 
 __all__ = ["line_of_sight", "smooth_path"]
 
@@ -51,22 +51,24 @@ def _cell_blocks(ax, ay, bx, by, x0, y0, res, clear):
 
 @njit(cache=True)
 def line_of_sight(ax, ay, bx, by, occ, ox, oy, res, clear):
-    """True when segment ``AB`` stays ``>= clear`` from every occupied square and the map edge.
+    """True when segment ``AB`` stays ``>= clear`` from every occupied square and inside the map,
+    at least ``clear - MARGIN_FRAC * res`` (the robot's radius) from its edge.
 
     The same answer as :func:`pathfuse.geometry.segment_is_clear`, visiting a
     strip of cells along the segment instead of its bounding box.
     """
     h, w = occ.shape
-    xmin = ox + clear
-    ymin = oy + clear
-    xmax = ox + w * res - clear
-    ymax = oy + h * res - clear
+    edge = max(clear - MARGIN_FRAC * res, 0.0)  # the edge rule of segment_is_clear:
+    xmin = ox + edge  # the robot's radius from the map's edge, the margin only from squares
+    ymin = oy + edge
+    xmax = ox + w * res - edge
+    ymax = oy + h * res - edge
     if not (xmin <= ax <= xmax and xmin <= bx <= xmax and ymin <= ay <= ymax
             and ymin <= by <= ymax):
         return False
     dx = bx - ax
     dy = by - ay
-    pad = clear + res  # one cell more than needed: rounding never leaves a square out
+    pad = clear + 1e-7 * res  # a sliver more than needed: rounding never leaves a square out
     if abs(dx) >= abs(dy):
         # column by column: the segment's y over the column's x-range (grown by clear)
         lo_x = min(ax, bx)

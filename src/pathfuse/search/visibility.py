@@ -20,8 +20,10 @@ Definition (what ``shortest`` computes, exactly)
       ``radius + MARGIN_FRAC * res``, which every pathfuse move keeps) also
       keeps L-infinity distance ``rho`` (``1/sqrt(2) > 1/2``), so no pathfuse
       planner's path is shorter, for a point robot;
-    * for a point robot the length exceeds ``L*`` by at most ``3 rho`` per
-      corner (``1.5e-6`` cells).
+    * for a point robot the length exceeds ``L*`` by at most ``2 sqrt(2) rho``
+      (under ``1.5e-6`` cells) per point where the limit path touches an
+      obstacle (moving such a point by ``sqrt(2) rho`` lengthens its two
+      segments by at most that much each).
 
     For a disc robot of radius ``r`` the grown squares are the configuration
     space of an axis-aligned *square* robot of half-side ``r``, which contains
@@ -77,55 +79,67 @@ def growth_cells(robot_radius_m: float, res: float) -> float:
     return robot_radius_m / res + 0.5 * MARGIN_FRAC
 
 
+@njit(cache=True, inline="always")
+def _corner(i, j, k, q):
+    """Corner ``k`` of the square of cell ``(i, j)`` grown by ``q``: ``(x, y, type)``."""
+    if k == 0:
+        return j - q, i - q, 1
+    if k == 1:
+        return j + 1 + q, i + 1 + q, 1
+    if k == 2:
+        return j + 1 + q, i - q, -1
+    return j - q, i + 1 + q, -1
+
+
+@njit(cache=True, inline="always")
+def _is_convex(occ, i, j, cx, cy, q, win):
+    """Whether the corner ``(cx, cy)`` of cell ``(i, j)``'s grown square lies in the inset map
+    and in no other grown square."""
+    h, w = occ.shape
+    if not (q <= cx <= w - q and q <= cy <= h - q):
+        return False
+    for i2 in range(max(i - win, 0), min(i + win, h - 1) + 1):
+        for j2 in range(max(j - win, 0), min(j + win, w - 1) + 1):
+            if occ[i2, j2] and (i2 != i or j2 != j) and \
+                    j2 - q <= cx <= j2 + 1 + q and i2 - q <= cy <= i2 + 1 + q:
+                return False
+    return True
+
+
 @njit(cache=True)
 def convex_corners(occ, q):
     """Convex corners of the squares grown by ``q`` cells (cell units, origin 0).
 
     Returns ``(x, y, t)``: coordinates and the tangency type (``+1``:
     bottom-left or top-right corner, a tangent line has ``dx * dy <= 0``;
-    ``-1``: bottom-right or top-left, ``dx * dy >= 0``).
+    ``-1``: bottom-right or top-left, ``dx * dy >= 0``).  Two passes (count,
+    then fill), so the arrays hold exactly the corners.
     """
     h, w = occ.shape
-    n = 0
-    for i in range(h):
-        for j in range(w):
-            if occ[i, j]:
-                n += 1
-    xs = np.empty(4 * n)
-    ys = np.empty(4 * n)
-    ts = np.empty(4 * n, dtype=np.int64)
     win = int(math.ceil(2.0 * q)) + 1
     m = 0
     for i in range(h):
         for j in range(w):
-            if not occ[i, j]:
-                continue
-            for k in range(4):
-                if k == 0:
-                    cx, cy, t = j - q, i - q, 1
-                elif k == 1:
-                    cx, cy, t = j + 1 + q, i + 1 + q, 1
-                elif k == 2:
-                    cx, cy, t = j + 1 + q, i - q, -1
-                else:
-                    cx, cy, t = j - q, i + 1 + q, -1
-                if not (q <= cx <= w - q and q <= cy <= h - q):
-                    continue
-                inside = False
-                for i2 in range(max(i - win, 0), min(i + win, h - 1) + 1):
-                    for j2 in range(max(j - win, 0), min(j + win, w - 1) + 1):
-                        if occ[i2, j2] and (i2 != i or j2 != j) and \
-                                j2 - q <= cx <= j2 + 1 + q and i2 - q <= cy <= i2 + 1 + q:
-                            inside = True
-                            break
-                    if inside:
-                        break
-                if not inside:
-                    xs[m] = cx
-                    ys[m] = cy
-                    ts[m] = t
-                    m += 1
-    return xs[:m], ys[:m], ts[:m]
+            if occ[i, j]:
+                for k in range(4):
+                    cx, cy, t = _corner(i, j, k, q)
+                    if _is_convex(occ, i, j, cx, cy, q, win):
+                        m += 1
+    xs = np.empty(m)
+    ys = np.empty(m)
+    ts = np.empty(m, dtype=np.int64)
+    m = 0
+    for i in range(h):
+        for j in range(w):
+            if occ[i, j]:
+                for k in range(4):
+                    cx, cy, t = _corner(i, j, k, q)
+                    if _is_convex(occ, i, j, cx, cy, q, win):
+                        xs[m] = cx
+                        ys[m] = cy
+                        ts[m] = t
+                        m += 1
+    return xs, ys, ts
 
 
 @njit(cache=True)
@@ -238,12 +252,13 @@ def _vis_kernel(occ, q, xs, ys, ts, g, parent, closed, hkey, hnode, meta, max_ex
     return 1, hkey, hnode
 
 
-_CORNERS: dict[tuple[int, bytes, float], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+_CORNERS: dict[tuple[tuple[int, ...], bytes, float],
+               tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 
 def _corners_cached(occ: np.ndarray, q: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The convex corners of a map, cached per (map content, growth) for repeated queries."""
-    key = (occ.shape[1], np.packbits(occ).tobytes(), q)
+    key = (tuple(occ.shape), np.packbits(occ).tobytes(), q)
     hit = _CORNERS.get(key)
     if hit is None:
         if len(_CORNERS) >= 16:
@@ -252,10 +267,12 @@ def _corners_cached(occ: np.ndarray, q: float) -> tuple[np.ndarray, np.ndarray, 
     return hit
 
 
-def _outside_squares(x: float, y: float, occ: np.ndarray, q: float) -> bool:
-    """Whether the point (cell units) lies in the inset map and in no grown square's interior."""
+def _outside_squares(x: float, y: float, occ: np.ndarray, q: float, qe: float) -> bool:
+    """Whether the point (cell units) lies in the map inset by ``qe`` (the robot's radius: the
+    edge rule of :func:`pathfuse.geometry.segment_is_clear`, which keeps pathfuse's margin
+    from the squares only) and in no grown square's interior."""
     h, w = occ.shape
-    if not (q <= x <= w - q and q <= y <= h - q):
+    if not (qe <= x <= w - qe and qe <= y <= h - qe):
         return False
     c0, c1 = max(int(math.floor(x - q)) - 1, 0), min(int(math.floor(x + q)) + 1, w - 1)
     r0, r1 = max(int(math.floor(y - q)) - 1, 0), min(int(math.floor(y + q)) + 1, h - 1)
@@ -274,8 +291,8 @@ def shortest_path(occ: np.ndarray, ox: float, oy: float, res: float, robot_radiu
     """The shortest path from ``start`` to ``goal`` (world metres; see the module docstring).
 
     ``NO_PATH`` also when the start or the goal lies within the growth
-    ``rho`` (L-infinity) of a square or the map's edge.  ``max_expansions``
-    caps the vertices expanded (``MAX_ITERATIONS``).
+    ``rho`` (L-infinity) of a square, or within the robot's radius of the map's
+    edge.  ``max_expansions`` caps the vertices expanded (``MAX_ITERATIONS``).
 
     ``upper_bound_m``, the length of any path (an A* path, say), speeds the
     search up without changing its answer: only corners ``v`` with ``|s v| +
@@ -286,10 +303,11 @@ def shortest_path(occ: np.ndarray, ox: float, oy: float, res: float, robot_radiu
     t0 = time.perf_counter()
     occ = np.ascontiguousarray(occ, dtype=np.bool_)
     q = growth_cells(robot_radius_m, res)
+    qe = robot_radius_m / res
     sx, sy = (start[0] - ox) / res, (start[1] - oy) / res
     gx, gy = (goal[0] - ox) / res, (goal[1] - oy) / res
     for x, y in ((sx, sy), (gx, gy)):
-        if not _outside_squares(x, y, occ, q):
+        if not _outside_squares(x, y, occ, q, qe):
             return AnyAngleResult(Status.NO_PATH, np.zeros((0, 2)), math.inf, 0)
     cx, cy, ct = _corners_cached(occ, q)
     used = 0

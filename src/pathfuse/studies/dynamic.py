@@ -89,6 +89,10 @@ class DynamicConfig:
         Master seed of :func:`~pathfuse.world.generate.generate_scenarios`.
     params : mapping
         Per-planner parameter overrides, ``{name: {key: value}}``.
+    robot : mapping
+        A scenario ``robot:`` block for every scenario (e.g. ``{"model":
+        "diff-drive"}``); empty: the generator's default holonomic robot
+        (radius 0.2 m, 1 m/s, 3 m sensing).
 
     Examples
     --------
@@ -106,6 +110,7 @@ class DynamicConfig:
     planners: tuple[str, ...] = ()
     seed: int = 0
     params: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    robot: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         from pathfuse.planners.registry import REGISTRY, get_planner, make_params, planner_names
@@ -168,6 +173,27 @@ class DynamicConfig:
             if not isinstance(p, Mapping):
                 raise ConfigError(f"params.{n}: expected a mapping of parameters, got {_shown(p)}")
             make_online_params(get_online_planner(n), p, key=f"params.{n}")
+        if not isinstance(self.robot, Mapping):
+            raise ConfigError(f"robot: expected a robot block {{key: value}}, got {self.robot!r}")
+        from pathfuse.world.robot import parse_robot
+
+        parse_robot(dict(self.robot))
+        object.__setattr__(self, "robot", dict(self.robot))
+
+    def robot_label(self) -> str:
+        """The robot in words, for reports."""
+        from pathfuse.world.robot import parse_robot
+
+        rb = parse_robot(dict(self.robot) or None).to_model()
+        text = (f"robot radius {rb.radius_m:g} m at {rb.max_speed_mps:g} m/s with "
+                f"{rb.sensing_radius_m:g} m sensing, {rb.kind}")
+        if rb.is_diff_drive:
+            text += (f" (acceleration {rb.max_accel_mps2:g} m/s^2, yaw rate "
+                     f"{rb.max_yaw_rate_radps:g} rad/s, yaw acceleration "
+                     f"{rb.max_yaw_accel_radps2:g} rad/s^2)")
+        if rb.clearance_m:
+            text += f", safety margin {rb.clearance_m:g} m"
+        return text
 
     def choice(self, name: str) -> dict[str, Any]:
         """The ``planner`` argument of :func:`pathfuse.simulate` for ``name``."""
@@ -211,7 +237,9 @@ def dynamic_experiment(config: DynamicConfig | None = None,
         "seeds": cfg.n_seeds,
         "maps": [{"name": f"k{k}",
                   "dynamic": {"generate": {"moving": k, "speed_range": [lo, hi],
-                                           "name": f"dyn-k{k}"},
+                                           "name": f"dyn-k{k}",
+                                           **({"robot": dict(cfg.robot)} if cfg.robot
+                                              else {})},
                               "family_seed": cfg.seed}} for k in cfg.moving],
         "planners": [{"name": n, "params": dict(cfg.params.get(n, {})), "kinds": ["dynamic"]}
                      if cfg.params.get(n) else {"name": n, "kinds": ["dynamic"]}
@@ -442,8 +470,8 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
         f"{cfg.n_seeds} generated scenarios per number of moving discs "
         f"({', '.join(map(str, cfg.moving))}), seed {cfg.seed}: paper map family "
         "(15 m x 15 m, 50 random cells, a new map per scenario, the same maps for every "
-        "disc count), start (1, 1), goal (11, 11), robot radius 0.2 m at 1 m/s with 3 m "
-        f"sensing, discs of radius 0.2-0.4 m at {lo:g}-{hi:g} m/s aimed across the route, "
+        f"disc count), start (1, 1), goal (11, 11), {cfg.robot_label()}, "
+        f"discs of radius 0.2-0.4 m at {lo:g}-{hi:g} m/s aimed across the route, "
         "dt 0.1 s, time limit 60 s.  Planner parameters: "
         f"{params}.\n\n"
         f"{len(run.records)} episodes in {run.wall_s:.2f} s "

@@ -57,6 +57,7 @@ from pathfuse.world.obstacles import (
     PatrolObstacle,
     RandomWalkObstacle,
 )
+from pathfuse.world.robot import parse_robot
 from pathfuse.world.scenario import RobotSpec, Scenario, ScenarioError, resolve_planner_choice
 
 __all__ = ["generate_scenarios", "KINDS", "PLACEMENTS"]
@@ -185,7 +186,7 @@ def generate_scenarios(
     kinds: Sequence[str] = KINDS,
     radius_range: Sequence[float] = (0.2, 0.4),
     placement: str = "route",
-    robot: RobotSpec | None = None,
+    robot: RobotSpec | Mapping[str, Any] | None = None,
     dt: float = 0.1,
     time_limit: float = 60.0,
     goal_tolerance: float = 0.25,
@@ -221,8 +222,9 @@ def generate_scenarios(
         Disc radii are drawn from it.
     placement : {"route", "uniform"}
         See the module docstring.
-    robot : RobotSpec, optional
-        Default ``RobotSpec()`` (radius 0.2 m, 1 m/s, sensing 3 m).
+    robot : RobotSpec or mapping, optional
+        Default ``RobotSpec()`` (radius 0.2 m, 1 m/s, sensing 3 m, holonomic);
+        a mapping is read as a scenario's ``robot:`` block.
     dt, time_limit, goal_tolerance : float
         As in a scenario file.
     planner : str or mapping
@@ -258,6 +260,8 @@ def generate_scenarios(
         raise ConfigError(f"placement must be one of {', '.join(PLACEMENTS)}, "
                           f"got {_shown(placement)}")
     check_body_ticks(time_limit, dt, moving)  # before placing any disc
+    if isinstance(robot, Mapping):
+        robot = parse_robot(dict(robot), ConfigError)
     robot = robot or RobotSpec()
     choice = resolve_planner_choice(planner)
     fixed_grid: GridMap | None = None

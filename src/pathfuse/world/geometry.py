@@ -1,5 +1,9 @@
 """Exact continuous collision geometry for disc robots and disc obstacles.
 
+The two segment kernels live in :mod:`pathfuse.sweep` (a lower layer, so that
+the controllers use them too, beside the arc checks of a diff-drive robot)
+and are re-exported here under their old names.
+
 Everything here works on *segments*: over one tick every body moves in a
 straight line at constant speed, so a collision check over the whole tick is
 a closed-form minimum distance, not a sample of end points.
@@ -9,7 +13,7 @@ a closed-form minimum distance, not a sample of end points.
   outside of the map*.  A disc of radius ``r`` swept along the segment
   overlaps a cell or leaves the map exactly when this distance is ``< r``.
   The distance from a segment to a square is exact
-  (:func:`pathfuse.field.stepper.segment_box_distance`: zero when they
+  (:func:`pathfuse.geometry.segment_box_distance`: zero when they
   intersect, else the least of the end-point-to-square and corner-to-segment
   distances).  Cells are visited ring by ring outwards from the
   segment's bounding box and the search stops once a ring is farther than the

@@ -26,7 +26,7 @@ from hypothesis import strategies as st
 from pathfuse import GridMap, Status, plan
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
-from pathfuse.metrics import collision_free, evaluate, path_length
+from pathfuse.metrics import collision_free, evaluate, path_length, segment_clearances
 from pathfuse.search.los import line_of_sight, smooth_path
 from pathfuse.search.visibility import growth_cells, shortest_path
 
@@ -72,15 +72,54 @@ def test_line_of_sight_on_grid_aligned_segments(g, xy, clear, res):
     assert line_of_sight(ax, ay, bx, by, occ, 0.0, 0.0, res, clear * res) == want
 
 
-def test_line_of_sight_on_long_segments():
+def _clear_by_metrics(occ, ox, oy, res, ax, ay, bx, by, clear):
+    """An independent answer: the exact clearance of pathfuse.metrics (its own kernels) from
+    every occupied square, and the edge rule; None when it is within rounding of ``clear``."""
+    h, w = occ.shape
+    edge = max(clear - MARGIN_FRAC * res, 0.0)
+    x0, y0, x1, y1 = ox + edge, oy + edge, ox + w * res - edge, oy + h * res - edge
+    if not all(x0 <= x <= x1 for x in (ax, bx)) or not all(y0 <= y <= y1 for y in (ay, by)):
+        return False
+    g = GridMap(occ, res, (ox, oy))
+    d = float(segment_clearances(g, [[ax, ay], [bx, by]])[0])
+    if abs(d - clear) < 1e-9 * max(1.0, res):
+        return None
+    return d >= clear
+
+
+def test_long_segments_against_an_independent_clearance():
+    # long oblique segments take the strip scan in segment_is_clear (and line_of_sight
+    # always does): both against the metrics' exact clearance, which scans differently
     rng = np.random.default_rng(0)
-    occ = rng.random((200, 300)) < 0.02
-    for _ in range(300):
-        ax, bx = rng.uniform(0, 300, 2)
-        ay, by = rng.uniform(0, 200, 2)
-        for clear in (1e-6, 0.7):
-            assert line_of_sight(ax, ay, bx, by, occ, 0.0, 0.0, 1.0, clear) == \
-                segment_is_clear(ax, ay, bx, by, occ, 0.0, 0.0, 1.0, clear)
+    checked = 0
+    for occ in (rng.random((200, 300)) < 0.02, rng.random((60, 90)) < 0.2):
+        h, w = occ.shape
+        for _ in range(300):
+            ax, bx = rng.uniform(0, w, 2)
+            ay, by = rng.uniform(0, h, 2)
+            for clear in (1e-6, 0.7):
+                want = _clear_by_metrics(occ, 0.0, 0.0, 1.0, ax, ay, bx, by, clear)
+                if want is None:
+                    continue
+                assert segment_is_clear(ax, ay, bx, by, occ, 0.0, 0.0, 1.0, clear) == want
+                assert line_of_sight(ax, ay, bx, by, occ, 0.0, 0.0, 1.0, clear) == want
+                checked += 1
+    assert checked > 1000
+
+
+@settings(max_examples=300, deadline=None)
+@given(grids(max_side=40), st.lists(st.floats(0.0, 1.0), min_size=4, max_size=4),
+       st.sampled_from([0.0, 1e-6, 0.3, 1.3]), st.sampled_from([1.0, 0.05]))
+def test_segment_is_clear_against_an_independent_clearance(g, uv, clear, res):
+    occ = g[0]
+    h, w = occ.shape
+    ax, bx = uv[0] * w * res - 0.3, uv[1] * w * res - 0.3
+    ay, by = uv[2] * h * res + 0.2, uv[3] * h * res + 0.2
+    want = _clear_by_metrics(occ, -0.3, 0.2, res, ax, ay, bx, by, clear * res)
+    if clear == 0.0 or want is None:  # a point touching a square: the metrics' own rule
+        return
+    assert segment_is_clear(ax, ay, bx, by, occ, -0.3, 0.2, res, clear * res) == want
+    assert line_of_sight(ax, ay, bx, by, occ, -0.3, 0.2, res, clear * res) == want
 
 
 def test_smooth_path_keeps_sight_and_shortens():

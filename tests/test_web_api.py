@@ -17,17 +17,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("starlette")
-pytest.importorskip("httpx")
-
 with warnings.catch_warnings():  # starlette suggests httpx2, a fork; httpx works
     warnings.simplefilter("ignore")
-    from starlette.testclient import TestClient  # noqa: E402
+    from starlette.testclient import TestClient
 
-import pathfuse  # noqa: E402
-from pathfuse.cli import main  # noqa: E402
-from pathfuse.web.app import create_app  # noqa: E402
-from pathfuse.web.maps import Limits, grid_from_bits, grid_to_json  # noqa: E402
+import pathfuse
+from pathfuse.cli import main
+from pathfuse.validate import param_spec
+from pathfuse.web.app import create_app
+from pathfuse.web.maps import Limits, grid_from_bits, grid_to_json
 
 DATA = Path(__file__).parent / "data"
 ROOT = Path(__file__).resolve().parents[1]
@@ -99,10 +97,12 @@ def test_planners_loop_over_the_registry(client):
         fields = dataclasses.fields(spec.params_cls)
         assert [q["name"] for q in p["params"]] == [f.name for f in fields]
         defaults = spec.params_cls()
-        for q in p["params"]:
+        for q, f in zip(p["params"], fields, strict=True):
             assert q["default"] == getattr(defaults, q["name"])
             assert q["kind"] in ("float", "int", "bool", "choice", "str")
-            assert q["help"]
+            ps = param_spec(f)
+            if ps is not None:  # declared with param(): its metadata (test plug-ins may not)
+                assert q["help"] == ps.help and q["unit"] == ps.unit and q["kind"] == ps.kind
         assert ("closed" in p["layers"]) == spec.uses_astar
     fusion = next(p for p in got if p["name"] == "fusion")
     r1 = next(q for q in fusion["params"] if q["name"] == "r1_m")
@@ -370,6 +370,23 @@ def _sleepy(seconds):
                                    planner="nap")
 
     pathfuse.register_function("nap", nap, P, "sleeps")
+
+
+def test_a_planner_that_raises_is_a_500_with_its_message(client):
+    from pathfuse.planners.params import Checked
+
+    @dataclasses.dataclass(frozen=True)
+    class P(Checked):
+        pass
+
+    def broken(grid, start, goal, params, budget):
+        raise RuntimeError("plug-in bug")
+
+    pathfuse.register_function("broken", broken, P, "raises")
+    r = client.post("/api/plan", json={"map": "paper", "planner": "broken"})
+    assert r.status_code == 500
+    assert r.json()["error"] == "internal error: RuntimeError: plug-in bug"
+    assert client.post("/api/plan", json={"map": "paper"}).status_code == 200  # still serving
 
 
 def test_a_request_over_the_budget_is_503():

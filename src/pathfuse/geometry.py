@@ -36,8 +36,8 @@ import math
 
 from numba import njit
 
-__all__ = ["MARGIN_FRAC", "segment_box_distance", "segment_is_clear", "point_box_distance",
-           "point_segment_distance"]
+__all__ = ["MARGIN_FRAC", "segment_box_distance", "segment_is_clear", "strip_is_clear",
+           "point_box_distance", "point_segment_distance"]
 
 #: Clearance every move keeps from occupied squares beyond the robot radius, in cells: a
 #: safe robot never *touches* a square (the metrics count a touch as a collision).
@@ -113,6 +113,72 @@ def segment_box_distance(ax, ay, bx, by, x0, y0, x1, y1):
     return d
 
 
+@njit(cache=True, inline="always")
+def _cell_blocks(ax, ay, bx, by, x0, y0, res, clear):
+    """Whether the square ``[x0, x0+res] x [y0, y0+res]`` is closer than ``clear`` to ``AB``."""
+    # cheap exact rejection: missing the box grown by ``clear`` as a square means the
+    # distance (to the box grown by a disc) is above ``clear``
+    if not _segment_hits_box(ax, ay, bx, by, x0 - clear, y0 - clear, x0 + res + clear,
+                             y0 + res + clear):
+        return False
+    return segment_box_distance(ax, ay, bx, by, x0, y0, x0 + res, y0 + res) < clear
+
+
+@njit(cache=True)
+def strip_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear):
+    """Whether no occupied square is closer than ``clear`` to segment ``AB`` (the map's edge
+    is not checked), visiting only a strip of cells along the segment.
+
+    Column by column (row by row for a steep segment): the cells whose square
+    can come within ``clear`` of the part of ``AB`` over that column, so
+    ``O(length)`` cells where the bounding box holds ``O(length^2)``.  The
+    strip reaches ``1e-7`` cell beyond ``clear``, so the rounding of its bounds
+    never leaves out a square within ``clear``; the exact per-cell test decides.
+    """
+    h, w = occ.shape
+    dx = bx - ax
+    dy = by - ay
+    pad = clear + 1e-7 * res  # a sliver more than needed: rounding never leaves a square out
+    if abs(dx) >= abs(dy):
+        # column by column: the segment's y over the column's x-range (grown by clear)
+        lo_x = min(ax, bx)
+        hi_x = max(ax, bx)
+        c0 = max(int(math.floor((lo_x - clear - ox) / res)), 0)
+        c1 = min(int(math.floor((hi_x + clear - ox) / res)), w - 1)
+        for c in range(c0, c1 + 1):
+            xa = max(ox + c * res - clear, lo_x)
+            xb = min(ox + (c + 1) * res + clear, hi_x)
+            if dx != 0.0:
+                ya = ay + dy * (xa - ax) / dx
+                yb = ay + dy * (xb - ax) / dx
+            else:
+                ya = ay
+                yb = by
+            r0 = max(int(math.floor((min(ya, yb) - pad - oy) / res)), 0)
+            r1 = min(int(math.floor((max(ya, yb) + pad - oy) / res)), h - 1)
+            x0 = ox + c * res
+            for r in range(r0, r1 + 1):
+                if occ[r, c] and _cell_blocks(ax, ay, bx, by, x0, oy + r * res, res, clear):
+                    return False
+    else:
+        lo_y = min(ay, by)
+        hi_y = max(ay, by)
+        r0 = max(int(math.floor((lo_y - clear - oy) / res)), 0)
+        r1 = min(int(math.floor((hi_y + clear - oy) / res)), h - 1)
+        for r in range(r0, r1 + 1):
+            ya = max(oy + r * res - clear, lo_y)
+            yb = min(oy + (r + 1) * res + clear, hi_y)
+            xa = ax + dx * (ya - ay) / dy
+            xb = ax + dx * (yb - ay) / dy
+            c0 = max(int(math.floor((min(xa, xb) - pad - ox) / res)), 0)
+            c1 = min(int(math.floor((max(xa, xb) + pad - ox) / res)), w - 1)
+            y0 = oy + r * res
+            for c in range(c0, c1 + 1):
+                if occ[r, c] and _cell_blocks(ax, ay, bx, by, ox + c * res, y0, res, clear):
+                    return False
+    return True
+
+
 @njit(cache=True)
 def segment_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear):
     """True when segment ``AB`` stays ``>= clear`` from every occupied square and inside the
@@ -121,6 +187,10 @@ def segment_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear):
     The map's edge is not an obstacle: a robot may touch it (and a point robot may stand
     and move on it, the lower and left edges being part of the map), so the margin that
     keeps a robot from *touching* an occupied square is not kept from the edge.
+
+    A short move scans the cells of its bounding box; a long, oblique segment (a box of
+    more than 16 cells) only the strip of cells along it (:func:`strip_is_clear`), with
+    the same exact test per cell, so the answer is the same.
     """
     h, w = occ.shape
     edge = max(clear - MARGIN_FRAC * res, 0.0)
@@ -135,16 +205,11 @@ def segment_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear):
     c1 = min(int(math.floor((max(ax, bx) + clear - ox) / res)), w - 1)
     r0 = max(int(math.floor((min(ay, by) - clear - oy) / res)), 0)
     r1 = min(int(math.floor((max(ay, by) + clear - oy) / res)), h - 1)
+    if (c1 - c0 + 1) * (r1 - r0 + 1) > 16:
+        return strip_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear)
     for r in range(r0, r1 + 1):
         y0 = oy + r * res
         for c in range(c0, c1 + 1):
-            if occ[r, c]:
-                x0 = ox + c * res
-                # cheap exact rejection: missing the box grown by ``clear`` as a square
-                # means the distance (to the box grown by a disc) is above ``clear``
-                if not _segment_hits_box(ax, ay, bx, by, x0 - clear, y0 - clear,
-                                         x0 + res + clear, y0 + res + clear):
-                    continue
-                if segment_box_distance(ax, ay, bx, by, x0, y0, x0 + res, y0 + res) < clear:
-                    return False
+            if occ[r, c] and _cell_blocks(ax, ay, bx, by, ox + c * res, y0, res, clear):
+                return False
     return True

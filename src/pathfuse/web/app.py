@@ -129,6 +129,11 @@ def create_app(*, map_folders: list[tuple[str, Path]] | None = None, limits: Lim
             return _error(exc.status, str(exc))
         except PathfuseError as exc:
             return _error(400, str(exc))
+        except Exception as exc:  # noqa: BLE001 - a bug (or a plug-in's): say so, keep serving
+            import traceback
+
+            traceback.print_exc()
+            return _error(500, f"internal error: {type(exc).__name__}: {exc}")
         return _json(data)
 
     async def body_json(request: Request) -> Any:

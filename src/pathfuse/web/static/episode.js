@@ -55,12 +55,14 @@ export class Player {
     this.ui.time.max = ep.n_ticks; this.ui.time.value = 0;
     this.ui.time.disabled = false; this.ui.play.disabled = false;
     this.ui.play.textContent = "Play";
+    this.onTick(0);
     this.view.redraw();
   }
 
   unload() {
     this.pause();
     this.ep = null;
+    this.onTick(0);
     this.ui.time.disabled = true; this.ui.play.disabled = true;
     this.view.redraw();
   }

@@ -19,7 +19,10 @@ const state = {
 const view = new View($("canvas"));
 const scene = new Scene(() => { scene.renderList($("discs")); view.redraw(); });
 const player = new Player(view, { play: $("play"), time: $("time"), speed: $("play-speed") },
-  () => {});
+  (k) => {
+    const ep = player.ep;
+    $("time-label").textContent = ep ? `${(k * ep.dt).toFixed(1)} / ${(ep.n_ticks * ep.dt).toFixed(1)} s` : "";
+  });
 window.pathfuse = { state, view, scene, player };  // for the browser tests and the curious
 
 function setStatus(text) { $("status").textContent = text; }
@@ -122,6 +125,7 @@ function edited() {
   const m = state.map;
   if (!m) return;
   if ($("auto-plan").checked && m.width * m.height <= AUTO_CELLS) schedulePlan();
+  else setStatus(`${m.width} × ${m.height} cells: press Plan to plan (re-planning on every edit is for maps up to 256 × 256)`);
   if ($("layer-heat").checked || $("layer-arrows").checked) scheduleField();
   view.redraw();
 }
@@ -334,7 +338,7 @@ function drawArrows(ctx, v) {
 view.drawers.push(drawArrows);
 view.drawers.push((ctx, v) => {
   for (const [name, r] of state.results) {
-    if (r.error) continue;
+    if (r.error || (state.only && state.only !== name)) continue;  // only: one path alone
     const c = colorOf(name);
     if (r.extras && r.extras.astar_path && r.planner !== "astar") {
       v.polyline(ctx, r.extras.astar_path, c + "66", 1, [3, 3]);
@@ -358,6 +362,7 @@ view.drawers.push((ctx, v) => {
   v.disc(ctx, p[0], p[1], v.px(4), "#fff", "#9333ea", 2);
 });
 view.drawers.push((ctx, v) => {
+  if (player.ep) return;  // the episode draws the discs where they are
   for (const s of scene.starts()) {
     v.disc(ctx, s.p[0], s.p[1], s.r, "rgba(217,119,6,.35)", "#b45309", 1.5);
     if (s.v) v.arrow(ctx, s.p[0], s.p[1], s.v[0], s.v[1], "#b45309", 2);
@@ -419,8 +424,15 @@ canvas.addEventListener("pointerdown", (e) => {
   else drag = { kind: "pan", x: e.clientX, y: e.clientY };
 });
 canvas.addEventListener("pointermove", (e) => {
-  if (!drag) return;
   const w = eventWorld(e);
+  if (state.map) {
+    const [r, c] = view.cellAt(w[0], w[1]);
+    const m = state.map;
+    const inMap = r >= 0 && c >= 0 && r < m.height && c < m.width;
+    $("legend").textContent = `x ${w[0].toFixed(2)} m, y ${w[1].toFixed(2)} m` +
+      (inMap ? `, cell (${r}, ${c})${m.occ[r * m.width + c] ? " occupied" : ""}` : "");
+  }
+  if (!drag) return;
   if (drag.kind === "pan") {
     view.panBy(e.clientX - drag.x, e.clientY - drag.y);
     drag.x = e.clientX; drag.y = e.clientY;
@@ -543,7 +555,11 @@ async function init() {
     getJSON("/api/planners"), getJSON("/api/maps"), getJSON("/api/scenarios")]);
   const box = $("planners");
   planners.forEach((p, i) => {
-    const f = plannerForm(p, PALETTE[i % PALETTE.length], () => { renderTable(); schedulePlan(); scheduleField(); });
+    const f = plannerForm(p, PALETTE[i % PALETTE.length], () => {
+      const m = state.map;
+      if (m && $("auto-plan").checked && m.width * m.height <= AUTO_CELLS) schedulePlan();
+      scheduleField();
+    });
     if (p.name === "astar" || p.name === "fusion") f.check.checked = true;
     state.forms.push(f);
     box.append(f.box);
@@ -571,6 +587,7 @@ async function init() {
   $("sim-run").addEventListener("click", runEpisode);
   $("sim-export").addEventListener("click", exportScene);
   $("discs-clear").addEventListener("click", () => { scene.clear(); player.unload(); });
+  scene.onChange = () => { scene.renderList($("discs")); player.unload(); };
   $("scenario-load").addEventListener("click", loadScenario);
   $("scenario-file").addEventListener("change", uploadScenario);
   await loadSelectedMap();

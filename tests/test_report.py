@@ -107,6 +107,17 @@ def t_ci(x) -> tuple[float, float, float]:
     return m, float(lo), float(hi)
 
 
+def boot_ci(x) -> tuple[float, float, float]:
+    """The percentile bootstrap of the mean the report promises: 2000 resamples, seed 0."""
+    x = np.asarray(x, dtype=float)
+    m = float(x.mean())
+    if x.size == 1:
+        return m, m, m
+    idx = np.random.default_rng(0).integers(0, x.size, size=(2000, x.size))
+    lo, hi = np.quantile(x[idx].mean(axis=1), [0.025, 0.975])
+    return m, float(lo), float(hi)
+
+
 @pytest.fixture(scope="module")
 def study(tmp_path_factory):
     d = tmp_path_factory.mktemp("study")
@@ -183,7 +194,10 @@ def check_row(row: dict[str, str], runs: list[sqlite3.Row], r_by_id: dict[int, f
         if not vals:
             assert row[f"{key}_mean{unit}"] == ""
             continue
-        m, lo, hi = t_ci(vals)
+        m, lo, hi = t_ci(vals) if key == "length" else boot_ci(vals)
+        if key != "length":  # a time: its interval stays within the data, above zero
+            assert min(vals) <= num(row[f"{key}_ci_low{unit}"]) <= m
+            assert m <= num(row[f"{key}_ci_high{unit}"]) <= max(vals)
         assert num(row[f"{key}_mean{unit}"]) == pytest.approx(m, rel=1e-12)
         assert num(row[f"{key}_ci_low{unit}"]) == pytest.approx(lo, rel=1e-9, abs=1e-12)
         assert num(row[f"{key}_ci_high{unit}"]) == pytest.approx(hi, rel=1e-9, abs=1e-12)
@@ -377,7 +391,20 @@ def test_files_pngs_html_and_markdown(study):
     for h in ("success [95% CI]", "R_length mean [95% CI]", "time to goal (s) mean [95% CI]",
               "collisions [95% CI]", "pairs"):
         assert h in md and h in page
-    assert md.count("\n| configuration |") == 4  # 3 entries + the pooled static entries
+    # 3 entries + the pooled static entries, each as three tables (outcomes, lengths and
+    # times, R_length) narrow enough for a window: at most 9 columns
+    assert md.count("\n| configuration |") == 12
+    heads = [ln for ln in md.splitlines() if ln.startswith("| configuration |")
+             or ln.startswith("| scope |")]
+    assert heads and max(h.count(" | ") + 1 for h in heads) <= 9
+    # no planning-time interval below zero; a row's mean, interval and median share decimals
+    for ln in md.splitlines():
+        cells = [c.strip() for c in ln.strip("|").split("|")]
+        for c in cells:
+            if " [" in c and c[0].isdigit() and "%" not in c:
+                vals = c.replace("[", "").replace("]", "").replace(",", "").split()
+                assert all(not v.startswith("-") for v in vals), ln
+                assert len({len(v.split(".")[-1]) for v in vals}) == 1, c
     assert "### fusion (static): parameter r1_m" in md
 
 

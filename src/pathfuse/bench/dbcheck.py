@@ -93,10 +93,10 @@ def check_study_file(path: str | os.PathLike[str], write: bool) -> bool:
 
 
 def _check_content(p: Path, write: bool) -> None:
-    wal = p.with_name(p.name + "-wal")
-    # without a pending write-ahead log the file alone is the database: read it as immutable,
-    # so SQLite creates no -shm/-wal files beside it
-    quiet = not wal.exists() or wal.stat().st_size == 0
+    # with no -wal/-shm beside it no connection is open and the file alone is the database:
+    # read it as immutable, so SQLite creates no files beside it (otherwise a sweep may be
+    # writing it: read it normally, through its write-ahead log)
+    quiet = not any(p.with_name(p.name + x).exists() for x in ("-wal", "-shm"))
     uri = p.resolve().as_uri() + ("?mode=ro&immutable=1" if quiet else "?mode=ro")
     try:
         conn = sqlite3.connect(uri, uri=True, timeout=60.0)

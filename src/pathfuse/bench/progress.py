@@ -11,7 +11,8 @@ The rate and the time left are measured from the first finished item on,
 so starting the workers (and loading kernels) does not make the first
 estimate absurd; until two updates have come in, the line says
 ``starting`` instead of a rate.  The last line gives that rate and the
-whole elapsed time (start-up included).
+time since :meth:`start` (a sweep calls it once its kernels are compiled,
+before it starts its workers).
 ``unit`` names what is counted (runs, episodes, lines).
 
 Examples
@@ -109,6 +110,8 @@ class ProgressBar:
     def start(self) -> None:
         """Restart the clock (after a set-up phase that should not count)."""
         self.t0 = time.perf_counter()
+        if not self.tty:  # the first plain line comes interval_s after the start
+            self._last = self.t0
         if self.enabled and self.tty:
             self._write(self.t0, force=True)
 

@@ -132,13 +132,24 @@ def _pct_ci(row: Mapping[str, Any], key: str, count: str, n: str) -> str:
             f"[{100 * row[key + '_ci_low']:.1f}, {100 * row[key + '_ci_high']:.1f}]")
 
 
+def _decimals(v: float, digits: int = 3, most: int = 4) -> int:
+    """Decimals that show ``v`` with ``digits`` significant digits (at most ``most``)."""
+    if not np.isfinite(v) or v == 0:
+        return 2
+    return int(min(most, max(0, digits - 1 - math.floor(math.log10(abs(v))))))
+
+
 def _num_ci(row: Mapping[str, Any], base: str, unit: str = "", scale: float = 1.0,
-            fmt: str = "{:.3f}") -> str:
+            fmt: str | None = None) -> tuple[str, str]:
+    """``"mean [low, high]"`` and the median, all with the decimals of the mean (``fmt``
+    fixes them; default 3 significant digits of the mean)."""
     m = row[f"{base}_mean{unit}"]
     if not np.isfinite(m):
-        return "n/a"
+        return "n/a", "n/a"
+    f = fmt or f"{{:.{_decimals(m * scale)}f}}"
     lo, hi = row[f"{base}_ci_low{unit}"] * scale, row[f"{base}_ci_high{unit}"] * scale
-    return f"{fmt.format(m * scale)} [{fmt.format(lo)}, {fmt.format(hi)}]"
+    return (f"{f.format(m * scale)} [{f.format(lo)}, {f.format(hi)}]",
+            _num(row[f"{base}_median{unit}"], scale, f))
 
 
 def _num(v: float, scale: float = 1.0, fmt: str = "{:.3f}") -> str:
@@ -153,43 +164,45 @@ def _r_cell(row: Mapping[str, Any]) -> str:
 
 
 def _table(rows: Sequence[Mapping[str, Any]], first: Sequence[tuple[str, str]],
-           dynamic: bool) -> list[list[str]]:
-    head = [h for h, _ in first] + [
-        "runs", "success [95% CI]", "errors", "not solved by status", "collision-free "
-        "(solved)"]
-    if dynamic:
-        head += ["collisions [95% CI]", "time to goal (s) mean [95% CI]", "median"]
-    head += ["length (m) mean [95% CI]", "median", "time (ms) mean [95% CI]", "median",
-             "R_length mean [95% CI]", "median", "pairs", "shorter"]
+           dynamic: bool) -> list[list[list[str]]]:
+    """Three tables of at most nine columns (a window's width): outcomes, lengths and
+    times, R_length (and the excess over the shortest path, when the study has one).
+
+    Lengths in m with 3 decimals, times with 3 significant digits (mean, interval and
+    median of a row alike), rates in % with 1 decimal, R_length and the excess with 2.
+    """
+    key = [h for h, _ in first]
+    out_head = key + ["runs", "success [95% CI]", "errors", "not solved by status",
+                      "collision-free (solved)"] + (["collisions [95% CI]"] if dynamic else [])
+    num_head = key + ["length (m) mean [95% CI]", "median", "time (ms) mean [95% CI]",
+                      "median"] + (["time to goal (s) mean [95% CI]", "median"] if dynamic
+                                   else [])
+    r_head = key + ["R_length mean [95% CI]", "median", "shorter / pairs"]
     excess = any(r.get("excess_pairs") for r in rows)
     if excess:
-        head += ["excess over the shortest path mean [95% CI]", "median", "pairs"]
-    table = [head]
+        r_head += ["excess over the shortest path mean [95% CI]", "median", "pairs"]
+    outcomes, numbers, ratios = [out_head], [num_head], [r_head]
     for r in rows:
-        line = [str(r[k]) for _, k in first] + [
+        k = [str(r[c]) for _, c in first]
+        outcomes.append(k + [
             str(r["runs"]), _pct_ci(r, "success", "solved", "runs"), str(r["errors"]),
             r["failures"] or "-",
             _pct_ci(r, "collision_free", "collision_free", "collision_checked")]
-        if dynamic:
-            line += [_pct_ci(r, "collision", "collision_runs", "runs"),
-                     _num_ci(r, "time_to_goal", "_s", fmt="{:.2f}"),
-                     _num(r["time_to_goal_median_s"], fmt="{:.2f}")]
-        line += [_num_ci(r, "length", "_m"), _num(r["length_median_m"]),
-                 _num_ci(r, "time", "_s", 1e3, "{:.4g}"),
-                 _num(r["time_median_s"], 1e3, "{:.4g}"),
-                 _r_cell(r),
-                 "n/a" if not r["r_length_pairs"] else f"{100 * r['r_length_median']:+.2f}%",
-                 str(r["r_length_pairs"]),
-                 f"{r['r_length_shorter']}/{r['r_length_pairs']}" if r["r_length_pairs"]
-                 else "n/a"]
+            + ([_pct_ci(r, "collision", "collision_runs", "runs")] if dynamic else []))
+        numbers.append(k + [*_num_ci(r, "length", "_m", fmt="{:.3f}"),
+                            *_num_ci(r, "time", "_s", 1e3)]
+                       + (list(_num_ci(r, "time_to_goal", "_s")) if dynamic else []))
+        pairs = r["r_length_pairs"]
+        line = k + [_r_cell(r), f"{100 * r['r_length_median']:+.2f}%" if pairs else "n/a",
+                    f"{r['r_length_shorter']}/{pairs}" if pairs else "n/a"]
         if excess:
             n = r.get("excess_pairs", 0)
             line += ["n/a" if not n else
                      f"{100 * r['excess_mean']:+.2f}% [{100 * r['excess_ci_low']:+.2f}, "
                      f"{100 * r['excess_ci_high']:+.2f}]",
                      "n/a" if not n else f"{100 * r['excess_median']:+.2f}%", str(n)]
-        table.append(line)
-    return table
+        ratios.append(line)
+    return [outcomes, numbers, ratios]
 
 
 def _slug(text: str) -> str:
@@ -208,7 +221,7 @@ def _csv_value(v: Any) -> Any:
 class _Section:
     title: str
     text: str = ""
-    table: list[list[str]] | None = None
+    tables: list[list[list[str]]] = field(default_factory=list)
     images: list[tuple[str, str]] = field(default_factory=list)  # (file name, caption)
     level: int = 2
 
@@ -218,8 +231,12 @@ _NOTES = (
     "(ERROR) are never dropped: they count as not solved. Success rate: solved / runs "
     "with a 95% Wilson score interval. Collision-free: solved runs whose path is "
     "collision-free / solved runs that were checked. Length (and time to goal) over solved "
-    "runs; planning time over every run that did not raise; means with a 95% Student-t "
-    "interval. R_length = (L - L_ref) / L_ref over the runs where the run and its "
+    "runs; planning time over every run that did not raise. Means come with a 95% "
+    "interval: Student-t for length and R_length; for planning time and time to goal, "
+    "which are positive and skewed, a percentile bootstrap (2000 resamples, seed 0), whose "
+    "ends are means of resampled runs and so never go below zero. Numbers: lengths in m "
+    "with 3 decimals, times with 3 significant digits, rates in %. "
+    "R_length = (L - L_ref) / L_ref over the runs where the run and its "
     "reference both solved the same problem (problem_key + seed); pairs = how many; "
     "shorter = pairs where the configuration's path is shorter than the reference's. "
     "R_length < 0: shorter than the reference. When the study ran the planner shortest (the "
@@ -350,7 +367,7 @@ def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[st
 
         sec = _Section(f"{scope} ({kind}, {len(runs)} runs)",
                        text=f"Map entry `{study.experiments[eid].name}`.")
-        sec.table = _table(srows, [("configuration", "config")], kind == "dynamic")
+        sec.tables = _table(srows, [("configuration", "config")], kind == "dynamic")
         name = f"length_{slug}.png"
         viz.plot_boxes(labels, values("solution_length"), out / name,
                        xlabel="path length [m] (solved runs)", title=f"{scope}: path length",
@@ -389,7 +406,7 @@ def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[st
             continue
         srows = [r for r in rows if r["scope"] == scope]
         sec = _Section(f"{scope}: every {kind} map entry pooled ({n_exp} entries)")
-        sec.table = _table(srows, [("configuration", "config")], kind == "dynamic")
+        sec.tables = _table(srows, [("configuration", "config")], kind == "dynamic")
         runs = [r for r in study.runs if r["kind"] == kind]
         cids = sorted({r["plannerid"] for r in runs})
         rvals = [np.array([100 * rl[r["id"]] for r in runs
@@ -437,7 +454,7 @@ def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[st
                            text=f"Every configuration of {planner} with the same value of "
                                 f"{p} pooled (over the other swept parameters).")
             shown = [r for r in pr if not r["pooled"] or n_exp > 1]
-            sec.table = _table(shown, [("scope", "scope"), (p, "value"),
+            sec.tables = _table(shown, [("scope", "scope"), (p, "value"),
                                        ("configs", "configs")], kind == "dynamic")
             sec.images.append((name, f"{p} against success rate (95% Wilson) and mean length "
                                      "(95% t)"))
@@ -489,8 +506,8 @@ def _markdown(head: Sequence[str], sections: Sequence[_Section]) -> str:
         out += ["#" * s.level + " " + s.title, ""]
         if s.text:
             out += [s.text, ""]
-        if s.table:
-            out += [markdown_table(s.table), ""]
+        for t in s.tables:
+            out += [markdown_table(t), ""]
         for name, cap in s.images:
             out += [f"![{cap}]({name})", ""]
     return "\n".join(out)
@@ -532,10 +549,10 @@ def _html(study: Study, head: Sequence[str], sections: Sequence[_Section], out: 
         parts.append(f"<h{s.level} id='s{i}'>{e(s.title)}</h{s.level}>")
         if s.text:
             parts.append(f"<p>{md_inline(s.text)}</p>")
-        if s.table:
-            rows = ["<tr>" + "".join(f"<th>{e(c)}</th>" for c in s.table[0]) + "</tr>"]
+        for t in s.tables:
+            rows = ["<tr>" + "".join(f"<th>{e(c)}</th>" for c in t[0]) + "</tr>"]
             rows += ["<tr>" + "".join(f"<td>{e(str(c))}</td>" for c in r) + "</tr>"
-                     for r in s.table[1:]]
+                     for r in t[1:]]
             parts.append("<table>" + "".join(rows) + "</table>")
         for name, cap in s.images:
             if embed:

@@ -76,6 +76,8 @@ class SweepSummary:
     workers: int = 1
     scheduler: str | None = None
     error_samples: list[str] = field(default_factory=list)
+    compile_s: float = 0.0
+    """Seconds of ``wall_s`` spent compiling (or loading) kernels before the runs started."""
     stored_errors: int = 0
     """Runs skipped because they are stored as ``ERROR`` (``retry_errors`` runs them)."""
 
@@ -103,8 +105,10 @@ class SweepSummary:
             return (f"{self.experiment}: nothing to run, all {self.total} runs are already "
                     f"stored in {self.db_path} ('pathfuse report {self.db_path}' summarises "
                     f"them){errs}")
+        comp = f", {self.compile_s:.1f} s of it compiling kernels" \
+            if self.compile_s >= 1.0 else ""
         head = (f"{self.experiment}: {self.ran} runs in {self.wall_s:.1f} s "
-                f"({self.runs_per_s:.1f} runs/s, {where}); {self.skipped} already stored; "
+                f"({self.runs_per_s:.1f} runs/s, {where}{comp}); {self.skipped} already stored; "
                 f"{stored}/{self.total} in {self.db_path}")
         tail = (f"\n  of the {self.ran} run now: solved {self.succeeded}, not solved "
                 f"{self.failed}, errors {self.errors}")
@@ -366,9 +370,11 @@ def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_st
         state = "failed"
         try:
             if todo and scheduler is None:  # compile once here; workers load from the cache
+                tw = time.perf_counter()
                 warm_kernels([r.planner for r in todo], metrics=True,
                              world=any(r.kind == "dynamic" for r in todo),
                              notify=bar.notice if enabled else None)
+                summary.compile_s = time.perf_counter() - tw
                 bar.start()
             if not todo:
                 pass

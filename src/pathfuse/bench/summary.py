@@ -12,7 +12,9 @@ A *run* here is a dict with the columns of the result store
 counted, never dropped: rates are over every run of the group, errors
 included; lengths and times to goal are over the solved runs (so two planners
 are compared on different subsets; paired values compare them on the same
-problems).
+problems).  Means come with 95 % intervals: Student-t for lengths and
+R_length, a seeded percentile bootstrap for planning times and times to goal
+(skewed, positive values whose t interval can go below zero).
 
 Examples
 --------
@@ -33,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from pathfuse.stats import mean_ci, wilson_ci
+from pathfuse.stats import bootstrap_mean_ci, mean_ci, wilson_ci
 
 __all__ = ["group_stats", "value_stats", "rate_stats", "median"]
 
@@ -53,14 +55,18 @@ def rate_stats(k: int, n: int, prefix: str) -> dict[str, float]:
     return {f"{prefix}_rate": p, f"{prefix}_ci_low": lo, f"{prefix}_ci_high": hi}
 
 
-def value_stats(values: Sequence[float], prefix: str, unit: str = "") -> dict[str, Any]:
+def value_stats(values: Sequence[float], prefix: str, unit: str = "",
+                ci: str = "t") -> dict[str, Any]:
     """``prefix_n``, ``prefix_mean{unit}``, ``prefix_ci_low{unit}``, ``prefix_ci_high{unit}`` and
-    ``prefix_median{unit}``: the mean with its 95 % Student-t interval, and the median.
+    ``prefix_median{unit}``: the mean with its 95 % interval, and the median.
+
+    ``ci="t"``: Student-t (lengths, R_length); ``ci="bootstrap"``: percentile bootstrap,
+    2000 resamples, seed 0 (times: skewed and positive, their interval stays above zero).
 
     >>> value_stats([1.0, 3.0], "length", "_m")["length_median_m"]
     2.0
     """
-    m, lo, hi = mean_ci(values)
+    m, lo, hi = bootstrap_mean_ci(values) if ci == "bootstrap" else mean_ci(values)
     return {f"{prefix}_n": len(values), f"{prefix}_mean{unit}": m,
             f"{prefix}_ci_low{unit}": lo, f"{prefix}_ci_high{unit}": hi,
             f"{prefix}_median{unit}": median(values)}
@@ -100,8 +106,8 @@ def group_stats(runs: Sequence[Mapping[str, Any]], rl: Mapping[int, float] | Non
         **rate_stats(cf, len(checked), "collision_free"),
         "collision_runs": coll, **rate_stats(coll, n, "collision"),
         **value_stats(lengths, "length", "_m"),
-        **value_stats(times, "time", "_s"),
-        **value_stats(ttg, "time_to_goal", "_s"),
+        **value_stats(times, "time", "_s", ci="bootstrap"),
+        **value_stats(ttg, "time_to_goal", "_s", ci="bootstrap"),
         **{k.replace("r_length_n", "r_length_pairs"): v
            for k, v in value_stats(rv, "r_length").items()},
         "r_length_shorter": sum(v < 0 for v in rv),

@@ -110,8 +110,7 @@ def cmd_barn(args: argparse.Namespace) -> int:
                      planners=planners,
                      resolution=base.resolution if args.resolution is None else args.resolution,
                      robot=robot, dt=base.dt if args.dt is None else args.dt, params=params)
-    for name in cfg.planners:
-        _warm_with_notice(name)
+    _warm_with_notice(list(cfg.planners), world=True)  # one notice for all of them
     run = run_barn(cfg, workers=args.workers, scheduler=args.scheduler,
                    db_path=_study_db(args.out), progress=False if args.quiet else None,
                    trajectories=args.json)

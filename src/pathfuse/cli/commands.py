@@ -6,6 +6,7 @@ import argparse
 import json
 import math
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -49,7 +50,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
         plot_plan(
             grid, result, start, goal, args.plot,
             title=f"{grid.name}: {args.planner} {result.status.name} {result.length:.3f} m",
-            astar_points=result.info.get("astar_path"),
+            astar_points=result.info.get("astar_path"), robot_radius_m=args.robot_radius,
         )
     if args.json:
         d = result.to_dict()
@@ -118,15 +119,16 @@ def _progress(total: int, label: str, unit: str, args: argparse.Namespace) -> An
                        enabled=not getattr(args, "quiet", False))
 
 
-def _warm_with_notice(planner: str, world: bool = False) -> None:
-    """Compile the planner's kernels (and the world's) now, saying so first when numba's
-    cache is cold."""
+def _warm_with_notice(planner: str | Sequence[str], world: bool = False) -> None:
+    """Compile the kernels of the planner(s) (and the world's) now, saying so first, in one
+    line, when numba's cache is cold."""
     from pathfuse.bench.warmup import warm_kernels
 
     def notice(text: str) -> None:
         print(f"pathfuse: {text}", file=sys.stderr, flush=True)
 
-    warm_kernels([planner], metrics=False, world=world, notify=notice)
+    names = [planner] if isinstance(planner, str) else list(planner)
+    warm_kernels(names, metrics=False, world=world, notify=notice)
 
 
 def planner_table() -> dict[str, Any]:
@@ -217,7 +219,9 @@ def cmd_paper(args: argparse.Namespace) -> int:
     n_runs = len(run.records)
     sm = run.summary
     print(f"{n_runs} runs on {cfg.n_seeds} maps: {sm.ran} run now in {run.wall_s:.2f} s "
-          f"({sm.runs_per_s:.0f} runs/s, {sm.workers} worker{'s' if sm.workers != 1 else ''})"
+          f"({sm.runs_per_s:.0f} runs/s, {sm.workers} worker{'s' if sm.workers != 1 else ''}"
+          + (f", {sm.compile_s:.1f} s of it compiling kernels" if sm.compile_s >= 1.0 else "")
+          + ")"
           + (f", {sm.skipped} already in {sm.db_path}" if sm.skipped else ""))
     print(f"{'variant':<9} {'planner':<13} {'success':>12} {'length mean':>12} {'R_length':>10} "
           f"{'excess':>9} {'time mean':>11}")

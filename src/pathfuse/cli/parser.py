@@ -246,8 +246,10 @@ examples:
         "x parameter combinations) and store each in an SQLite study database in OMPL's "
         "benchmark layout.  Runs already stored are skipped, so running the same command "
         "again resumes an interrupted sweep.  Exit status 0 when no run raised, 1 when some "
-        "did (they are stored as ERROR with their traceback), 2 for a bad experiment file "
-        "or argument, 130 when interrupted (Ctrl-C; what finished is stored).",
+        "did (they are stored as ERROR with their traceback) or the Dask cluster was lost "
+        "(the unfinished runs stay missing), 2 for a bad experiment file or argument, or a "
+        "database that is damaged, read-only, not a study or being written by another "
+        "sweep, 130 when interrupted (Ctrl-C) and 143 on SIGTERM (what finished is stored).",
         epilog=_fmt("""
 examples:
   pathfuse bench experiments/paper-static-1000-seeds.yaml --db paper.db

@@ -16,7 +16,8 @@ per-episode CSV, whatever its status.
 status (they add up to the number of episodes), the success / collision /
 timeout / local-minimum / no-path rates with 95 % Wilson intervals, and path
 length and time to goal over the successful episodes (mean with a 95 %
-Student-t interval, median).  :func:`write_dynamic_outputs` writes them as
+interval: Student-t for the length, seeded bootstrap for the time; median).
+:func:`write_dynamic_outputs` writes them as
 Markdown and CSV with a plot of the success rate against ``K``.
 
 Examples
@@ -485,8 +486,10 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
         f"{markdown_table(table)}\n\n"
         "Counts per row add up to the episodes run (nothing dropped); rates carry 95% Wilson "
         "score intervals.  Path length and time to goal are over each planner's successful "
-        "episodes only (so planners are compared on different subsets), with a 95% Student-t "
-        "interval of the mean.  Plan time is the wall-clock time of the planner's per-tick "
+        "episodes only (so planners are compared on different subsets), with a 95% interval "
+        "of the mean: Student-t for the length, a percentile bootstrap (2000 resamples, seed "
+        "0) for the time to goal, which stays within the range of the data.  "
+        "Plan time is the wall-clock time of the planner's per-tick "
         "decision, averaged over ticks and then over episodes.\n"
     )
 

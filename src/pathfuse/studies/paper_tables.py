@@ -246,7 +246,9 @@ def _stats_tables(run: PaperRun, rows: list[dict[str, Any]], variant: str) -> st
         "on the maps where both succeeded.\n\n"
         f"### Table II over {n} maps, {variant} variant: processing time\n\n{_md(t2)}\n\n"
         "Times are wall-clock planning times in this process (A* included for the planners "
-        "that use it; numba compilation excluded by a warm-up call before timing).\n"
+        "that use it; numba compilation excluded by a warm-up call before timing).  The "
+        "interval of a mean time is a 95% percentile bootstrap (2000 resamples, seed 0), which "
+        "stays above zero; the other intervals are Student-t (Wilson for rates).\n"
     )
 
 

@@ -40,7 +40,7 @@ import math
 import shutil
 import subprocess
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -56,7 +56,8 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Circle, Patch  # noqa: E402
 
 from pathfuse.result import PathfuseError  # noqa: E402
-from pathfuse.viz.figures import draw_map  # noqa: E402
+from pathfuse.viz.dynamic import ONLINE_COLOURS, plot_success_vs_moving  # noqa: E402,F401
+from pathfuse.viz.figures import draw_map, map_legend_handles  # noqa: E402
 
 __all__ = [
     "AnimationError",
@@ -73,16 +74,6 @@ __all__ = [
 ]
 
 FORMATS = ("gif", "mp4")
-#: Line colours of the online planners (benchmark figure, animation title).
-ONLINE_COLOURS = {
-    "fusion": "#d62728",
-    "apf": "#ff7f0e",
-    "astar-follow": "#1f77b4",
-    "astar-replan": "#17becf",
-    "ref6": "#2ca02c",
-    "ref7": "#9467bd",
-}
-_FALLBACK_COLOURS = ("#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#000000")
 
 
 class AnimationError(PathfuseError):
@@ -197,20 +188,24 @@ class _EpisodeRenderer:
         self.dt = float(sc.dt)
         x0, y0, x1, y1 = grid.bounds
         w, h = x1 - x0, y1 - y0
-        scale = size_in / max(w, h)
-        fw, fh = max(2.5, w * scale) + 0.4, max(2.5, h * scale) + 1.3
+        # the map's longer side is size_in; a header (title, clock) and a footer (axis
+        # label, legend) outside the map, so nothing covers the clock or the map
+        aw, ah = size_in * w / max(w, h), size_in * h / max(w, h)
+        head, foot, left = 0.55, 1.25, 0.7
+        fw, fh = max(aw + left + 0.25, 6.4), ah + head + foot
         fig = Figure(figsize=(fw, fh), dpi=dpi)
         self.canvas = FigureCanvasAgg(fig)
         self.fig = fig
-        ax = fig.add_axes((0.1, 0.2, 0.86, 0.72))
+        ax = fig.add_axes((max(left, (fw - aw) / 2 + 0.2) / fw, foot / fh, aw / fw, ah / fh))
         self.ax = ax
-        draw_map(ax, grid)
-        ax.tick_params(labelsize=7)
-        ax.xaxis.label.set_fontsize(7)
-        ax.yaxis.label.set_fontsize(7)
-        ax.set_title(title if title is not None else f"{sc.name}: {ep.planner}", fontsize=9)
-        ax.plot(*sc.start, "o", color="#2ca02c", ms=7, mec="k", zorder=6)
-        ax.plot(*sc.goal, "*", color="#ffbf00", ms=12, mec="k", zorder=6)
+        drawn = draw_map(ax, grid)
+        ax.tick_params(labelsize=9)
+        ax.xaxis.label.set_fontsize(9)
+        ax.yaxis.label.set_fontsize(9)
+        fig.text(0.02, 1 - 0.2 / fh, title if title is not None else f"{sc.name}: {ep.planner}",
+                 ha="left", va="top", fontsize=11)
+        ax.plot(*sc.start, "o", color="#2ca02c", ms=8, mec="k", zorder=6)
+        ax.plot(*sc.goal, "*", color="#ffbf00", ms=14, mec="k", zorder=6)
         ax.add_patch(Circle(sc.goal, sc.goal_tolerance, fill=False, ec="#b08800", lw=0.8,
                             ls=":", zorder=6))
 
@@ -255,11 +250,10 @@ class _EpisodeRenderer:
         ax.add_patch(self.robot)
         (self.mark,) = ax.plot([], [], "X", color="#ff0000", mec="k", ms=14, zorder=9)
         add(self.mark)
-        box = {"boxstyle": "round,pad=0.25", "fc": "white", "ec": "0.5", "alpha": 0.85}
-        self.clock = add(ax.text(0.02, 0.98, "", transform=ax.transAxes, ha="left", va="top",
-                                 fontsize=8, family="monospace", bbox=box, zorder=10))
+        self.clock = add(fig.text(0.98, 1 - 0.2 / fh, "", ha="right", va="top", fontsize=10,
+                                  family="monospace"))
         self.outcome = add(ax.text(0.5, 0.5, "", transform=ax.transAxes, ha="center",
-                                   va="center", fontsize=11, weight="bold", zorder=11,
+                                   va="center", fontsize=12, weight="bold", zorder=11,
                                    bbox={"boxstyle": "round,pad=0.4", "fc": "white",
                                          "ec": "k", "alpha": 0.9}))
         self.outcome.set_visible(False)
@@ -272,9 +266,11 @@ class _EpisodeRenderer:
             Patch(fc="#ff7f0e", ec="#8a4500", label="moving obstacle (sensed)"),
             Patch(fc="#f4d3b0", ec="#8a4500", label="moving obstacle"),
             Line2D([], [], marker="*", ls="none", color="#ffbf00", mec="k", ms=9, label="goal"),
+            *map_legend_handles(drawn)[1:],  # unknown cells of a ROS map, when there are any
         ]
-        fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=6.5, frameon=False,
-                   handlelength=1.6, columnspacing=1.0)
+        fig.legend(handles=handles, loc="lower center", ncol=4 if fw >= 7 else 3, fontsize=9,
+                   frameon=False, handlelength=1.6, columnspacing=1.0,
+                   bbox_to_anchor=(0.5, 0.0))
         self.canvas.draw()
         self.background = self.canvas.copy_from_bbox(fig.bbox)
         w_px, h_px = self.canvas.get_width_height()
@@ -359,7 +355,7 @@ def _outcome_text(ep: Any) -> str:
     return f"{name} at t = {t} s"
 
 
-def render_frames(ep: Any, ticks: Sequence[int] | None = None, *, dpi: float = 80,
+def render_frames(ep: Any, ticks: Sequence[int] | None = None, *, dpi: float = 100,
                   size_in: float = 5.0, obstacle_trail_s: float | None = 3.0,
                   robot_trail: bool = True, title: str | None = None):
     """Yield the RGBA frames (H, W, 4 uint8 arrays) of ``ticks`` (default: every tick).
@@ -395,7 +391,7 @@ def animate_episode(
     frame_step: int | None = None,
     max_frames: int = 150,
     hold_s: float = 1.5,
-    dpi: float = 80,
+    dpi: float = 100,
     size_in: float = 5.0,
     obstacle_trail_s: float | None = 3.0,
     robot_trail: bool = True,
@@ -422,8 +418,9 @@ def animate_episode(
     hold_s : float
         Seconds the final frame (with the outcome) is shown.
     dpi, size_in : float
-        Resolution and the size of the map's longer side in inches
-        (defaults: about 430 x 500 pixels for a square map).
+        Resolution and the size of the map's longer side in inches (defaults:
+        640 x 680 pixels for a square map, 9-12 pt text; the title and the clock
+        sit above the map, the legend below it).
     obstacle_trail_s : float or None
         Length of the discs' trails in simulated seconds (None: whole run).
     robot_trail : bool
@@ -533,54 +530,3 @@ def _write_mp4(frames: Any, out: Path, fps: float, hold_s: float, exe: str) -> t
         raise AnimationError(f"ffmpeg failed writing {out} (exit {proc.returncode}): "
                              f"{msg[-1] if msg else 'no message'}")
     return size
-
-
-# --------------------------------------------------------------------------- benchmark figure
-def plot_success_vs_moving(
-    rows: Sequence[Mapping[str, Any]],
-    out: str | Path | None = None,
-    *,
-    title: str | None = None,
-    dpi: int = 120,
-) -> Figure:
-    """Success rate (with its 95 % Wilson interval) against the number of moving discs.
-
-    ``rows`` are summary rows of :func:`pathfuse.studies.dynamic.summary_rows` (keys
-    ``planner``, ``moving``, ``reached_rate``, ``reached_ci_low``,
-    ``reached_ci_high``); one line per planner, the points of different
-    planners nudged sideways so their error bars do not overlap.  Saved to
-    ``out`` (PNG) when given.
-    """
-    planners: list[str] = []
-    for r in rows:
-        if r["planner"] not in planners:
-            planners.append(r["planner"])
-    moving = sorted({int(r["moving"]) for r in rows})
-    gaps = np.diff(moving) if len(moving) > 1 else np.array([1.0])
-    nudge = 0.08 * float(gaps.min()) if gaps.size else 0.08
-    fig = Figure(figsize=(6.4, 4.2))
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot(1, 1, 1)
-    for i, name in enumerate(planners):
-        rs = sorted((r for r in rows if r["planner"] == name), key=lambda r: int(r["moving"]))
-        x = np.array([int(r["moving"]) for r in rs], dtype=float)
-        x = x + (i - (len(planners) - 1) / 2) * nudge
-        y = np.array([float(r["reached_rate"]) for r in rs])
-        lo = np.array([float(r["reached_ci_low"]) for r in rs])
-        hi = np.array([float(r["reached_ci_high"]) for r in rs])
-        colour = ONLINE_COLOURS.get(name, _FALLBACK_COLOURS[i % len(_FALLBACK_COLOURS)])
-        yerr = np.clip(100 * np.vstack([y - lo, hi - y]), 0.0, None)  # no -1e-15 from rounding
-        ax.errorbar(x, 100 * y, yerr=yerr, fmt="-o", ms=4,
-                    capsize=3, lw=1.5, color=colour, label=name)
-    ax.set_xticks(moving)
-    ax.set_xlabel("moving obstacles per scenario")
-    ax.set_ylabel("success rate [%] (95% Wilson CI)")
-    ax.set_ylim(-3, 103)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="lower left", framealpha=0.9)
-    if title:
-        ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    if out is not None:
-        fig.savefig(out, dpi=dpi)
-    return fig

@@ -8,7 +8,14 @@ from typing import Any
 
 import numpy as np
 
-from pathfuse.viz.figures import PLANNER_COLOURS, draw_map, plt
+from pathfuse.viz.figures import (
+    MEAN_PROPS,
+    PLANNER_COLOURS,
+    boxplot_key,
+    draw_astar,
+    draw_map,
+    plt,
+)
 
 __all__ = ["plot_fig3", "plot_r_length"]
 
@@ -35,8 +42,7 @@ def plot_fig3(results: Mapping[str, Any], seed: int, labels: Mapping[str, str],
     for ax, (name, tag) in zip(axes.ravel(), refs, strict=False):
         draw_map(ax, grid)
         if fusion is not None and "astar_path" in fusion.info:
-            a = np.asarray(fusion.info["astar_path"])
-            ax.plot(a[:, 0], a[:, 1], "o", ms=3, color="#1f77b4", alpha=0.6, label="A* points")
+            draw_astar(ax, np.asarray(fusion.info["astar_path"]), label="A* path (grid)")
         for res in (results[name], fusion):
             if res is None or len(res.path) == 0:
                 continue
@@ -61,9 +67,9 @@ def plot_r_length(r_by_ref: Mapping[str, np.ndarray], n_maps: int, labels: Mappi
     PAPER_LABELS = labels  # noqa: N806
 
     names = [k for k in r_by_ref if r_by_ref[k].size]
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = plt.subplots(figsize=(8, 5.2))
     if names:
-        ax.boxplot([100 * r_by_ref[k] for k in names], showmeans=True)
+        ax.boxplot([100 * r_by_ref[k] for k in names], showmeans=True, meanprops=MEAN_PROPS)
         ax.set_xticks(range(1, len(names) + 1))
         ax.set_xticklabels(
             [f"{PAPER_LABELS.get(k, k)}\n(n={r_by_ref[k].size})" for k in names], fontsize=8)
@@ -71,6 +77,7 @@ def plot_r_length(r_by_ref: Mapping[str, np.ndarray], n_maps: int, labels: Mappi
     ax.set_ylabel("R_length = (L_fusion - L_ref) / L_ref  [%]")
     ax.set_title(f"Fusion path length relative to each reference over "
                  f"{n_maps} maps (below 0: fusion shorter)", fontsize=10)
-    fig.tight_layout()
+    boxplot_key(fig)
+    fig.tight_layout(rect=(0, 0.7 / fig.get_figheight(), 1, 1))
     fig.savefig(out, dpi=dpi)
     plt.close(fig)

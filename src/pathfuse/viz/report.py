@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from pathfuse.viz.figures import plt
+from pathfuse.viz.figures import MEAN_PROPS, boxplot_key, plt
 
 __all__ = ["plot_boxes", "plot_parameter"]
 
@@ -32,7 +32,8 @@ def plot_boxes(labels: Sequence[str], values: Sequence[np.ndarray], out: str | P
     True
     """
     n = len(labels)
-    fig, ax = plt.subplots(figsize=(8.5, 1.2 + 0.32 * max(n, 2)))
+    key_in = 0.55  # the key of the box plot's parts, under the axes
+    fig, ax = plt.subplots(figsize=(8.5, 1.2 + key_in + 0.32 * max(n, 2)))
     data = [np.asarray(v, dtype=float) for v in values]
     data = [v[np.isfinite(v)] for v in data]
     pos = np.arange(n, 0, -1)  # first label at the top
@@ -45,8 +46,7 @@ def plot_boxes(labels: Sequence[str], values: Sequence[np.ndarray], out: str | P
         horiz = {"orientation": "horizontal"} if mpl >= (3, 10) else {"vert": False}
         ax.boxplot([data[i] for i in keep], positions=[pos[i] for i in keep], **horiz,
                    showmeans=True, widths=0.6, flierprops={"markersize": 3},
-                   meanprops={"marker": "^", "markerfacecolor": "#d62728",
-                              "markeredgecolor": "#d62728", "markersize": 5})
+                   meanprops=MEAN_PROPS)
         allv = np.concatenate([data[i] for i in keep])
         pos_v = allv[allv > 0]
         if log and pos_v.size == allv.size and pos_v.max() > 100 * pos_v.min():
@@ -60,7 +60,8 @@ def plot_boxes(labels: Sequence[str], values: Sequence[np.ndarray], out: str | P
     ax.set_xlabel(xlabel)
     ax.set_title(title, fontsize=10)
     ax.grid(axis="x", alpha=0.3)
-    fig.tight_layout()
+    boxplot_key(fig, fontsize=7.5)
+    fig.tight_layout(rect=(0, key_in / fig.get_figheight(), 1, 1))
     fig.savefig(out, dpi=dpi)
     plt.close(fig)
 
@@ -124,9 +125,10 @@ def plot_parameter(param: str, lines: Mapping[str, Sequence[Mapping[str, Any]]],
     a1.set_ylabel("success rate [%] (95% Wilson CI)")
     a1.set_ylim(-3, 103)
     a2.set_ylabel("path length mean [m] (95% t CI, solved runs)")
-    if k > 1:
-        a1.legend(fontsize=8)
+    if k > 1:  # under the plots, never over their points
+        fig.legend(*a1.get_legend_handles_labels(), loc="lower center", fontsize=8,
+                   ncol=min(k, 4), frameon=False)
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.1 if k > 1 else 0, 1, 1))
     fig.savefig(out, dpi=dpi)
     plt.close(fig)

@@ -130,7 +130,7 @@ def test_every_episode_rechecked_for_collision(barn_run):
             chord = np.hypot(*np.diff(pos, axis=0).T)
             turn = np.abs((np.diff(traj[:, 3]) + math.pi) % (2 * math.pi) - math.pi)
             sag = 1.01 * chord * turn / 8.0 + 1e-9
-            seg = segment_clearances(grid, pos)
+            seg = segment_clearances(grids[rec["world"]], pos)
             assert np.all(seg >= radius - sag), (rec["world"], rec["planner"],
                                                  float(np.min(seg - radius + sag)))
             gap = _segment_point_distance(pos[:-1], pos[1:], centres) - cyl_r[None, :]

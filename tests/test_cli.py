@@ -133,8 +133,12 @@ def test_paper_variant_and_corner_cutting(tmp_path):
             "--out", out, "--quiet")
     assert p.returncode == 0, p.stderr
     assert "fusion/paper" in p.stdout and "shortest" in p.stdout
+    # the fusion as printed fails on all three maps: its empty statistics read n/a, not nan
+    row = next(x for x in p.stdout.splitlines() if "fusion/paper" in x).split()
+    assert row[2:4] == ["0/3", "n/a"], row
     md = (out / "tables.md").read_text()
     assert "paper variant: path length" in md and "pathfuse variant" not in md
+    assert "nan" not in p.stdout.lower() and " nan " not in md
     assert "A-star (corner cutting)" in md and "with corner cutting" in md
     assert "Excess over the shortest path" in md
     p = run("paper", "--seeds", "2", "--variant", "pathfuse", "--no-references", "--workers",

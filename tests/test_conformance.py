@@ -380,3 +380,50 @@ def test_plan_and_simulate_use_the_same_defaults(name):
     spec = get_planner(name)
     ep = simulate(REACHABLE["corridor"], planner=name)
     assert ep.params == dataclasses.asdict(make_params(spec)) == spec.defaults()
+
+
+_NO_COMPILE_AFTER_WARM = r"""
+import sys
+from numba.core.registry import CPUDispatcher
+import pathfuse
+from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
+from pathfuse.planners.registry import get_planner, planner_names
+from pathfuse.planners.run import warm
+
+def signatures():
+    out = {}
+    for name, mod in list(sys.modules.items()):
+        if name.startswith("pathfuse"):
+            for v in list(vars(mod).values()):
+                if isinstance(v, CPUDispatcher):
+                    out[v.py_func.__module__ + "." + v.__name__] = len(v.signatures)
+    return out
+
+names = planner_names()
+for n in names:
+    warm(get_planner(n))
+before = signatures()
+for n in names:
+    for seed in (0, 1):
+        for radius in (0.0, 0.2):
+            r = pathfuse.plan(paper_map(seed), PAPER_START, PAPER_GOAL, planner=n,
+                              robot_radius_m=radius)
+            assert r.status.name in ("SUCCESS", "LOCAL_MINIMUM"), (n, seed, radius, r.message)
+after = signatures()
+print(" ".join(sorted(k for k, v in after.items() if v != before.get(k, 0))))
+"""
+
+
+def test_warm_up_compiles_every_signature_a_plan_uses(tmp_path):
+    """The warm-up is what keeps compilation out of the planners' timings: after
+    ``warm(spec)``, planning on a real GridMap (whose arrays are read-only, a different
+    numba type from a fresh array) must not compile or load any kernel again.  Run in a
+    fresh process, since this one has compiled everything already."""
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", _NO_COMPILE_AFTER_WARM], capture_output=True,
+                         text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    lines = out.stdout.strip().splitlines()
+    assert lines == [] or lines == [""], f"kernels compiled after the warm-up: {lines}"

@@ -226,10 +226,12 @@ def cmd_paper(args: argparse.Namespace) -> int:
     print(f"{'variant':<9} {'planner':<13} {'success':>12} {'length mean':>12} {'R_length':>10} "
           f"{'excess':>9} {'time mean':>11}")
     for r in summary_rows(run):
-        rl = "-" if r["is_fusion"] else f"{100 * r['r_length_mean']:+.2f}%"
+        rl = ("-" if r["is_fusion"] else "n/a" if not r["r_length_pairs"]
+              else f"{100 * r['r_length_mean']:+.2f}%")
         ex = "-" if not r["excess_pairs"] else f"{100 * r['excess_mean']:+.2f}%"
+        lm = f"{r['length_mean_m']:.4f}m" if r["successes"] else "n/a"
         print(f"{r['variant']:<9} {r['planner']:<13} {r['successes']:>5}/{r['maps']:<6} "
-              f"{r['length_mean_m']:>11.4f}m {rl:>10} {ex:>9} {1e3 * r['time_mean_s']:>9.3f}ms")
+              f"{lm:>12} {rl:>10} {ex:>9} {1e3 * r['time_mean_s']:>9.3f}ms")
     for path in files.values():
         print(f"wrote {path}")
     return 0

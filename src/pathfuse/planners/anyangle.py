@@ -222,8 +222,9 @@ def _warm(kind: str) -> None:
         from pathfuse.search.los import smooth_path
 
         astar_warmup()
-        smooth_path(np.array([[0.5, 0.5], [1.5, 0.5], [2.5, 1.5]]), np.zeros((3, 3), bool), 0.0,
-                    0.0, 1.0, 1e-6)
+        occ = np.zeros((3, 3), bool)
+        occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
+        smooth_path(np.array([[0.5, 0.5], [1.5, 0.5], [2.5, 1.5]]), occ, 0.0, 0.0, 1.0, 1e-6)
     elif kind == "shortest":
         from pathfuse.search import visibility
         from pathfuse.search.astar import warmup as astar_warmup

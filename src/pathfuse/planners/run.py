@@ -43,6 +43,12 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None) -> None:
 
     if notify is not None and cold_kernels(spec):
         notify()
+    if not _WARM:  # the robot-disc check of a query's end points (Problem.failure)
+        from pathfuse.geometry import segment_is_clear
+
+        occ = np.zeros((2, 2), dtype=bool)
+        occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
+        segment_is_clear(0.5, 0.5, 0.5, 0.5, occ, 0.0, 0.0, 1.0, 0.1)
     if spec.uses_astar:
         from pathfuse.search.astar import warmup as astar_warmup
 

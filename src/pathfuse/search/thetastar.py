@@ -333,6 +333,8 @@ def warmup(lazy: bool = False) -> None:
         return
     occ = np.zeros((3, 4), dtype=bool)
     occ[1, 1] = True
-    theta_star(~occ, occ, 0.0, 0.0, 1.0, 1e-6, (0, 0), (0.5, 0.5), (2, 3), (3.5, 2.5),
+    free = ~occ
+    occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
+    theta_star(free, occ, 0.0, 0.0, 1.0, 1e-6, (0, 0), (0.5, 0.5), (2, 3), (3.5, 2.5),
                lazy=lazy, time_limit_s=10.0)
     _WARM.add(lazy)

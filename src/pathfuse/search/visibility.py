@@ -382,5 +382,6 @@ def warmup() -> None:
         return
     occ = np.zeros((3, 4), dtype=bool)
     occ[1, 1] = True
+    occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
     shortest_path(occ, 0.0, 0.0, 1.0, 0.0, (0.5, 0.5), (3.5, 2.5))
     _WARM[0] = True

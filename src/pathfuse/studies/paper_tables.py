@@ -209,7 +209,9 @@ def _stats_tables(run: PaperRun, rows: list[dict[str, Any]], variant: str) -> st
         ["Failures by status"] + [by[k]["failures"] or "none" for k in names],
         ["Path length mean [95% CI] (m)"] + [
             ci(by[k], "length_mean_m", "length_ci_low_m", "length_ci_high_m") for k in names],
-        ["Path length median (m)"] + [f"{by[k]['length_median_m']:.4f}" for k in names],
+        ["Path length median (m)"] + [
+            "n/a" if not by[k]["successes"] else f"{by[k]['length_median_m']:.4f}"
+            for k in names],
         ["R_length mean [95% CI]"] + [rr(by[k], "r_length") for k in names],
         ["R_length median"] + [
             "-" if by[k]["is_fusion"] else _pct(by[k]["r_length_median"]) for k in names],

@@ -143,11 +143,11 @@ def strip_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear):
         # column by column: the segment's y over the column's x-range (grown by clear)
         lo_x = min(ax, bx)
         hi_x = max(ax, bx)
-        c0 = max(int(math.floor((lo_x - clear - ox) / res)), 0)
-        c1 = min(int(math.floor((hi_x + clear - ox) / res)), w - 1)
+        c0 = max(int(math.floor((lo_x - pad - ox) / res)), 0)
+        c1 = min(int(math.floor((hi_x + pad - ox) / res)), w - 1)
         for c in range(c0, c1 + 1):
-            xa = max(ox + c * res - clear, lo_x)
-            xb = min(ox + (c + 1) * res + clear, hi_x)
+            xa = max(ox + c * res - pad, lo_x)
+            xb = min(ox + (c + 1) * res + pad, hi_x)
             if dx != 0.0:
                 ya = ay + dy * (xa - ax) / dx
                 yb = ay + dy * (xb - ax) / dx
@@ -163,11 +163,11 @@ def strip_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear):
     else:
         lo_y = min(ay, by)
         hi_y = max(ay, by)
-        r0 = max(int(math.floor((lo_y - clear - oy) / res)), 0)
-        r1 = min(int(math.floor((hi_y + clear - oy) / res)), h - 1)
+        r0 = max(int(math.floor((lo_y - pad - oy) / res)), 0)
+        r1 = min(int(math.floor((hi_y + pad - oy) / res)), h - 1)
         for r in range(r0, r1 + 1):
-            ya = max(oy + r * res - clear, lo_y)
-            yb = min(oy + (r + 1) * res + clear, hi_y)
+            ya = max(oy + r * res - pad, lo_y)
+            yb = min(oy + (r + 1) * res + pad, hi_y)
             xa = ax + dx * (ya - ay) / dy
             xb = ax + dx * (yb - ay) / dy
             c0 = max(int(math.floor((min(xa, xb) - pad - ox) / res)), 0)
@@ -201,10 +201,11 @@ def segment_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear):
     if not (xmin <= ax <= xmax and xmin <= bx <= xmax and ymin <= ay <= ymax
             and ymin <= by <= ymax):
         return False
-    c0 = max(int(math.floor((min(ax, bx) - clear - ox) / res)), 0)
-    c1 = min(int(math.floor((max(ax, bx) + clear - ox) / res)), w - 1)
-    r0 = max(int(math.floor((min(ay, by) - clear - oy) / res)), 0)
-    r1 = min(int(math.floor((max(ay, by) + clear - oy) / res)), h - 1)
+    pad = clear + 1e-7 * res  # as strip_is_clear: rounding never leaves a square out
+    c0 = max(int(math.floor((min(ax, bx) - pad - ox) / res)), 0)
+    c1 = min(int(math.floor((max(ax, bx) + pad - ox) / res)), w - 1)
+    r0 = max(int(math.floor((min(ay, by) - pad - oy) / res)), 0)
+    r1 = min(int(math.floor((max(ay, by) + pad - oy) / res)), h - 1)
     if (c1 - c0 + 1) * (r1 - r0 + 1) > 16:
         return strip_is_clear(ax, ay, bx, by, occ, ox, oy, res, clear)
     for r in range(r0, r1 + 1):

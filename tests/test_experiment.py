@@ -309,12 +309,7 @@ def test_shipped_experiments_are_valid():
             cfg, _ = load_barn_file(f)
             assert len(find_worlds(cfg.directory, cfg.worlds)) == 250
             continue
-        try:
-            exp = load_experiment(f, seeds=2, check_maps=True)
-        except ConfigError as exc:
-            if "unknown planner" in str(exc):
-                pytest.skip(f"a planner of {f.name} is not registered yet: {exc}")
-            raise
+        exp = load_experiment(f, seeds=2, check_maps=True)
         has_dynamic = any(m.kind == "dynamic" for m in exp.maps)
         if not has_dynamic:
             assert exp.expand()

@@ -25,7 +25,6 @@ import pytest
 from pathfuse.bench import ResultStore, SweepInterrupted, comparable_rows, run_bench
 from pathfuse.bench.runner import make_batches
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
-from pathfuse.planners.registry import planner_names
 from pathfuse.result import ConfigError
 
 MOVINGAI = Path(__file__).resolve().parent / "data" / "movingai"
@@ -491,7 +490,6 @@ def test_make_batches_keeps_maps_together():
     assert make_batches([], workers=2) == []
 
 
-@pytest.mark.skipif("astar" not in planner_names(), reason="astar not registered yet")
 def test_real_planners_on_paper_maps(tmp_path):
     p = tmp_path / "real.yaml"
     p.write_text("""
@@ -538,10 +536,7 @@ maps:
     dynamic: {generate: {moving: 2, speed_range: [0.3, 0.6]}}
 planners: [astar-follow, {name: apf, params: {k_att: [20, 40]}}]
 """)
-    try:
-        s = run_bench(exp, tmp_path / "d.db", workers=1, progress=False)
-    except ConfigError as exc:  # the world module is still changing
-        pytest.skip(f"dynamic scenario not accepted by this build: {exc}")
+    s = run_bench(exp, tmp_path / "d.db", workers=1, progress=False)
     assert s.complete and s.errors == 0 and s.total == 2 * 2 * 3
     run_bench(exp, tmp_path / "p.db", workers=2, progress=False)
     rows = comparable_rows(tmp_path / "d.db")

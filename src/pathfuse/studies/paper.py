@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -51,6 +50,7 @@ from pathfuse.studies.paper_config import (
     REFERENCES,
     VARIANTS,
     PaperConfig,
+    PaperRun,
 )
 from pathfuse.studies.paper_tables import summary_rows, write_paper_outputs
 
@@ -70,25 +70,6 @@ __all__ = [
     "mean_ci",
     "wilson_ci",
 ]
-
-@dataclass
-class PaperRun:
-    """All records of a reproduction: one dict per (seed, planner), seed-major."""
-
-    config: PaperConfig
-    records: list[dict[str, Any]]
-    wall_s: float
-    results: dict[tuple[int, str], Any] = field(default_factory=dict, repr=False)
-    summary: Any = None
-    """The :class:`~pathfuse.bench.runner.SweepSummary` of the engine run."""
-
-    def by_planner(self, column: str) -> list[dict[str, Any]]:
-        """The records of one column (``fusion``, ``fusion/paper``, ``shortest``...)."""
-        return [r for r in self.records if r["planner"] == column]
-
-    def seeds(self) -> list[int]:
-        return sorted({r["seed"] for r in self.records})
-
 
 def paper_experiment(config: PaperConfig | None = None, base_dir: str | os.PathLike[str] = "."
                      ) -> Any:

@@ -10,7 +10,7 @@ from pathfuse.result import ConfigError
 from pathfuse.validate import short as _shown
 
 __all__ = ["PAPER_PLANNERS", "PAPER_LABELS", "PAPER_TABLE", "PAPER_VARIANT", "REFERENCES",
-           "VARIANTS", "PaperConfig"]
+           "VARIANTS", "PaperConfig", "PaperRun"]
 
 #: Column order of the paper's tables (the fusion planner last, as in Table I).
 PAPER_PLANNERS = ("astar", "apf", "ref6", "ref7", "fusion")
@@ -143,3 +143,22 @@ class PaperConfig:
         if name == "astar" and self.corner_cutting:
             text += " (corner cutting)"
         return f"{text} (as printed)" if variant == "paper" else text
+
+
+@dataclass
+class PaperRun:
+    """All records of a reproduction: one dict per (seed, planner), seed-major."""
+
+    config: PaperConfig
+    records: list[dict[str, Any]]
+    wall_s: float
+    results: dict[tuple[int, str], Any] = field(default_factory=dict, repr=False)
+    summary: Any = None
+    """The :class:`~pathfuse.bench.runner.SweepSummary` of the engine run."""
+
+    def by_planner(self, column: str) -> list[dict[str, Any]]:
+        """The records of one column (``fusion``, ``fusion/paper``, ``shortest``...)."""
+        return [r for r in self.records if r["planner"] == column]
+
+    def seeds(self) -> list[int]:
+        return sorted({r["seed"] for r in self.records})

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -12,10 +12,7 @@ from pathfuse.generate import PAPER_GOAL, PAPER_START
 from pathfuse.metrics import r_ratio
 from pathfuse.stats import markdown_table as _md
 from pathfuse.stats import write_csv as _write_csv
-from pathfuse.studies.paper_config import PAPER_LABELS, PAPER_PLANNERS, PAPER_TABLE
-
-if TYPE_CHECKING:
-    from pathfuse.studies.paper import PaperRun
+from pathfuse.studies.paper_config import PAPER_LABELS, PAPER_PLANNERS, PAPER_TABLE, PaperRun
 
 __all__ = ["summary_rows", "write_paper_outputs"]
 

@@ -4,7 +4,7 @@ Every file an example reads must exist in the repository (a new user copies the
 examples from a clone), and the quick examples (``plan``, ``scen``, ``simulate``,
 ``planners``) are run, from the repository's root, with their output files redirected
 into a temporary folder.  The long studies (``paper``, ``dynamic``, ``bench``,
-``report``) are only checked for their input files.
+``report``, ``barn``, ``serve``) are only checked for their input files.
 """
 
 from __future__ import annotations
@@ -18,7 +18,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-COMMANDS = ("plan", "scen", "paper", "simulate", "dynamic", "bench", "report", "planners")
+COMMANDS = ("plan", "scen", "paper", "simulate", "dynamic", "bench", "report", "planners",
+            "barn", "serve")
 OUTPUT_OPTIONS = ("--plot", "--gif", "--mp4", "--db", "--out")
 RUN = ("plan", "scen", "simulate", "planners")
 
@@ -92,7 +93,9 @@ def test_every_help_has_examples():
                          ids=[f"{w}:{' '.join(a)[:60]}" for w, a in EXAMPLES])
 def test_example_inputs_exist(where, argv):
     for f in _inputs(argv):
-        assert (ROOT / f).exists(), f"{where} --help names {f}, which is not in the repository"
+        path = (ROOT / f).resolve()
+        assert path.is_relative_to(ROOT) and path.exists(), \
+            f"{where} --help names {f}, which is not in the repository"
 
 
 RUNNABLE = [(w, a) for w, a in EXAMPLES if a[0] in RUN]

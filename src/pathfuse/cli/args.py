@@ -34,7 +34,7 @@ examples:
   pathfuse scen tests/data/movingai/maze-32-32-2.map tests/data/movingai/maze-32-32-2-random-1.scen
   pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
   pathfuse dynamic --seeds 50 --moving 0 2 4 8 --out dynamic-out
-  pathfuse barn ../shared/data/barn --worlds 0-24 --out barn-out
+  pathfuse barn tests/data/barn --out barn-out
   pathfuse bench experiments/fusion-sweep-r1-r2-step.yaml --db sweep.db --seeds 20
   pathfuse report sweep.db --out sweep-report
   pathfuse planners

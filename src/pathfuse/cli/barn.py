@@ -30,11 +30,11 @@ def add_barn_parser(sub: Any) -> None:
         "--out; --out/study.db keeps every episode, so the same command resumes.",
         epilog=_fmt("""
 examples:
-  pathfuse barn ../shared/data/barn --worlds 0-24 --planners fusion,astar-replan
+  pathfuse barn tests/data/barn --worlds 0-20 --planners fusion,astar-replan
   pathfuse barn experiments/barn-jackal.yaml --out barn-jackal
   pathfuse barn tests/data/barn --planners fusion --json > episodes.jsonl
-  pathfuse barn ../shared/data/barn --resolution 0.1 --workers 2 --out barn-out
-  pathfuse barn ../shared/data/barn --scheduler tcp://10.0.0.5:8786
+  pathfuse barn tests/data/barn --resolution 0.1 --workers 2 --out barn-out
+  pathfuse barn tests/data/barn --scheduler tcp://10.0.0.5:8786
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

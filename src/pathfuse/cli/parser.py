@@ -350,7 +350,7 @@ def _add_serve(sub: argparse._SubParsersAction) -> None:
         epilog=_fmt("""
 examples:
   pathfuse serve --open
-  pathfuse serve --port 8080 --maps ../shared/data/movingai
+  pathfuse serve --port 8080 --maps tests/data/movingai
   pathfuse serve --host 0.0.0.0 --port 8000     # reachable from other machines
 
 Needs the web extra: pip install "pathfuse[web]".

@@ -272,6 +272,9 @@ _CELL_COORD = st.one_of(
 # a diagonal between two squares touching at a corner, and a point far outside the map
 @example(occ=np.eye(2, dtype=bool)[::-1].copy(), res=0.5, origin=(-0.5, 1.25),
          cells=[(0.0, 0.0), (2.0, 2.0), (7.75, -2.0)])
+# a subnormal clearance first (its square underflows to 0), then a touching segment
+@example(occ=np.array([[False], [True], [False]]), res=1.0, origin=(0.0, 0.0),
+         cells=[(-5e-324, 1.0), (0.0, 0.0), (0.0, 4.25)])
 def test_segment_clearances_match_exact_brute_force(occ, res, origin, cells):
     g = GridMap(occ, resolution=res, origin=origin)
     path = np.asarray(origin) + np.array(cells) * res

@@ -261,7 +261,7 @@ def _pyramid_search(occ, pyr, meta, ox, oy, res, ax, ay, bx, by, best, ws):
                 y1 = oy + (min((ii + 1) * size, hgt)) * res + eps
                 gx = max(max(x0 - sx1, sx0 - x1), 0.0)
                 gy = max(max(y0 - sy1, sy0 - y1), 0.0)
-                if gx * gx + gy * gy >= best * best:
+                if math.hypot(gx, gy) >= best:  # not squares: best * best can underflow
                     continue  # even the boxes are too far apart
                 lb = _seg_box(ax, ay, bx, by, x0, y0, x1, y1)
                 if lb >= best:

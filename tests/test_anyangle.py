@@ -20,7 +20,7 @@ from fractions import Fraction
 import networkx as nx
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from pathfuse import GridMap, Status, plan
@@ -61,9 +61,14 @@ def test_line_of_sight_equals_segment_is_clear(g, xy, clear, res):
     assert got == want
 
 
+_TIE = np.zeros((7, 7), dtype=bool)  # square (6, 3) lies exactly at the clearance of B
+_TIE[1, 0] = _TIE[2, 1] = _TIE[2, 4] = _TIE[6, 3] = True
+
+
 @settings(max_examples=300, deadline=None)
 @given(grids(), st.lists(st.integers(0, 20), min_size=4, max_size=4),
        st.sampled_from([0.0, 1e-6, 0.5, 1.0]), st.sampled_from([1.0, 0.05, 0.1]))
+@example((_TIE, (0, 0), (0, 0)), [12, 5, 9, 12], 0.5, 0.05)  # both scans must see that square
 def test_line_of_sight_on_grid_aligned_segments(g, xy, clear, res):
     # end points on cell corners and centres: segments along grid lines and through corners
     occ = g[0]

@@ -51,6 +51,7 @@ __all__ = [
     "arc_static_distance",
     "arc_disc_gaps",
     "FINE_TOL_M",
+    "warmup_segments",
     "warmup_sweep",
 ]
 
@@ -315,18 +316,34 @@ def arc_disc_gaps(x: float, y: float, th: float, v: float, w: float, dt: float, 
     return out
 
 
-def warmup_sweep() -> None:
-    """Compile (or load from numba's cache) the arc kernels, for writeable and read-only
-    arrays (``GridMap.occupied`` and precomputed obstacle trajectories are read-only)."""
+def _warm_inputs() -> list[tuple[np.ndarray, np.ndarray]]:
+    """A tiny occupancy grid and disc positions, writeable and read-only
+    (``GridMap.occupied`` and precomputed obstacle trajectories are read-only, a
+    distinct numba type)."""
+    out = []
     for ro in (False, True):
         occ = np.zeros((2, 2), dtype=np.bool_)
         occ[0, 0] = True
         q = np.zeros((1, 2))
         occ.setflags(write=not ro)
         q.setflags(write=not ro)
-        arc_static_distance(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 0.0, 0.1, 0.5, 0.1, 0.1, 1.0)
+        out.append((occ, q))
+    return out
+
+
+def warmup_segments() -> None:
+    """Compile (or load from numba's cache) the straight-segment kernels (a holonomic
+    robot's ticks)."""
+    for occ, q in _warm_inputs():
         segment_static_distance(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.6, 1.2, 1.0)
-        arc_disc_gaps(0.0, 0.0, 0.0, 0.1, 0.5, 0.1, 0.1, q, q, np.ones(1))
         z = np.zeros(2)
         disc_sweep_gaps(z, z, 0.1, q, q, np.ones(1))
         disc_sweep_gaps(z, z, 0.1, q, np.zeros((1, 2)), np.ones(1))
+
+
+def warmup_sweep() -> None:
+    """Compile (or load from numba's cache) the segment and the arc kernels."""
+    warmup_segments()
+    for occ, q in _warm_inputs():
+        arc_static_distance(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 0.0, 0.1, 0.5, 0.1, 0.1, 1.0)
+        arc_disc_gaps(0.0, 0.0, 0.0, 0.1, 0.5, 0.1, 0.1, q, q, np.ones(1))

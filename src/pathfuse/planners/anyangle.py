@@ -49,8 +49,8 @@ from typing import Any, ClassVar
 import numpy as np
 
 from pathfuse.geometry import MARGIN_FRAC
-from pathfuse.planners.astar import FollowController, _point_at
-from pathfuse.planners.base import Observed, Outcome
+from pathfuse.planners.astar import FollowController
+from pathfuse.planners.base import Outcome
 from pathfuse.planners.global_astar import GlobalPlan, plan_global, snap_cell
 from pathfuse.planners.params import Checked, GlobalAStarParams
 from pathfuse.planners.registry import PlannerSpec, register
@@ -181,29 +181,16 @@ class PathController(FollowController):
     label = "follow the path"
     search_budget: ClassVar[bool] = True
     kind: ClassVar[str] = ""
+    # An any-angle path is taut: it turns where it touches the robot's clearance around an
+    # obstacle corner, so a move across a corner (from a point before it to one after it)
+    # would come closer than the radius.  Stopping on each corner costs at most one tick
+    # per corner, and these paths have few.
+    stop_at_corners: ClassVar[bool] = True
 
     def run(self, deadline: float | None) -> Outcome:
         gp = self.plan
         info = {"global_planner": self.kind, "corners": int(len(gp.points))}
         return Outcome(Status.SUCCESS, gp.points, 0, 0.0, gp.message, info, gp.length_m)
-
-    def act(self, obs: Observed) -> np.ndarray:
-        """Walk the path at full speed, but end a tick's move at the next corner.
-
-        An any-angle path is taut: it turns where it touches the robot's clearance
-        around an obstacle corner, so a move that cut across a corner (from a point
-        before it to a point after it, as the grid path's follower does) would come
-        closer than the radius.  Stopping on each corner costs at most one tick per
-        corner, and these paths have few.
-        """
-        cum = self._cum
-        s = min(self._s + self._step, float(cum[-1]))
-        nxt = int(np.searchsorted(cum, self._s, side="right"))
-        if nxt < len(cum) - 1 and cum[nxt] < s:
-            s = float(cum[nxt])
-        self._s = s
-        target = _point_at(self._path, cum, s)
-        return (target - obs.position) / float(self.dt)  # type: ignore[no-any-return, arg-type]
 
     @classmethod
     def warmup(cls) -> None:

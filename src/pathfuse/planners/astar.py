@@ -97,6 +97,9 @@ class FollowController(Controller):
     name = "astar"
     label = "follow the path"
     search_budget: ClassVar[bool] = True
+    #: End a tick's move at the path's next corner instead of cutting across it (the
+    #: any-angle followers: their taut paths touch the robot's clearance at the corners).
+    stop_at_corners: ClassVar[bool] = False
 
     def __init__(self, problem: Problem, params: Any, plan: Any = None, **kw: Any) -> None:
         super().__init__(problem, params, plan, **kw)
@@ -113,8 +116,14 @@ class FollowController(Controller):
         return Outcome(Status.SUCCESS, gp.points, 0, 0.0, gp.message, info, gp.length_m)
 
     def act(self, obs: Observed) -> np.ndarray:
-        self._s = min(self._s + self._step, float(self._cum[-1]))
-        target = _point_at(self._path, self._cum, self._s)
+        cum = self._cum
+        s = min(self._s + self._step, float(cum[-1]))
+        if self.stop_at_corners:
+            nxt = int(np.searchsorted(cum, self._s, side="right"))
+            if nxt < len(cum) - 1 and cum[nxt] < s:
+                s = float(cum[nxt])
+        self._s = s
+        target = _point_at(self._path, cum, s)
         return (target - obs.position) / float(self.dt)  # type: ignore[no-any-return, arg-type]
 
 

@@ -69,20 +69,6 @@ def dwa_progress(x, y, pts, cum, k, reach_m):
     return best
 
 
-@njit(cache=True, inline="always")
-def _point_seg(px, py, ax, ay, bx, by):
-    vx = bx - ax
-    vy = by - ay
-    l2 = vx * vx + vy * vy
-    t = 0.0
-    if l2 > 0.0:
-        t = ((px - ax) * vx + (py - ay) * vy) / l2
-        t = min(max(t, 0.0), 1.0)
-    ex = px - (ax + t * vx)
-    ey = py - (ay + t * vy)
-    return math.sqrt(ex * ex + ey * ey)
-
-
 @njit(cache=True)
 def _local_goal(pts, cum, k, look):
     """Index of the path point ``look`` metres of path beyond ``pts[k]`` (the last one)."""

@@ -47,10 +47,9 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
-from pathfuse.sweep import disc_sweep_gaps, segment_static_distance
+from pathfuse.sweep import disc_sweep_gaps, segment_static_distance, warmup_segments
 
 __all__ = [
     "segment_static_distance",
@@ -81,18 +80,7 @@ def point_segment_distance(px: float, py: float, ax: float, ay: float, bx: float
 
 
 def warmup_geometry() -> None:
-    """Compile (or load from numba's cache) the kernels of this module.
-
-    Both writeable and read-only arrays are used (``GridMap.occupied`` and the
-    precomputed obstacle trajectories are read-only, a distinct numba type).
-    """
-    for ro in (False, True):
-        occ = np.zeros((2, 2), dtype=np.bool_)
-        occ[0, 0] = True
-        q = np.zeros((1, 2))
-        occ.setflags(write=not ro)
-        q.setflags(write=not ro)
-        segment_static_distance(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.6, 1.2, 1.0)
-        z = np.zeros(2)
-        disc_sweep_gaps(z, z, 0.1, q, q, np.ones(1))
-        disc_sweep_gaps(z, z, 0.1, q, np.zeros((1, 2)), np.ones(1))
+    """Compile (or load from numba's cache) the kernels of this module (writeable and
+    read-only arrays: :func:`pathfuse.sweep.warmup_segments`)."""
+    warmup_segments()
+    point_segment_distance(1.0, 1.0, 0.0, 0.0, 2.0, 0.0)

@@ -37,6 +37,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.geometry import point_box_distance
+from pathfuse.search.heap import heap_pop, heap_push
 
 __all__ = ["CLEARANCE_COST", "clearance_multipliers", "costaware_search", "warmup_costaware"]
 
@@ -96,7 +97,7 @@ def clearance_multipliers(grid, radius_m: float, clearance_m: float) -> np.ndarr
 
 
 @njit(cache=True)
-def _search(occ, mult, sr, sc, gr, gc, corner_cutting, max_exp, keys, nodes):
+def _search(occ, mult, sr, sc, gr, gc, corner_cutting, max_exp):
     h, w = occ.shape
     n = h * w
     g = np.full(n, np.inf)
@@ -105,34 +106,13 @@ def _search(occ, mult, sr, sc, gr, gc, corner_cutting, max_exp, keys, nodes):
     start = sr * w + sc
     goal = gr * w + gc
     g[start] = 0.0
-    size = 0
-    # binary heap in (keys, nodes)
-    keys[0] = math.hypot(sr - gr, sc - gc)
-    nodes[0] = start
-    size = 1
+    keys = np.empty(1 << 12)
+    nodes = np.empty(1 << 12, dtype=np.int64)
+    keys, nodes, size = heap_push(keys, nodes, 0, math.hypot(sr - gr, sc - gc), start)
     exp = 0
     s2 = math.sqrt(2.0)
     while size > 0:
-        u = nodes[0]
-        size -= 1
-        if size > 0:
-            kk = keys[size]
-            nn = nodes[size]
-            i = 0
-            while True:
-                ch = 2 * i + 1
-                if ch >= size:
-                    break
-                if ch + 1 < size and keys[ch + 1] < keys[ch]:
-                    ch += 1
-                if keys[ch] < kk:
-                    keys[i] = keys[ch]
-                    nodes[i] = nodes[ch]
-                    i = ch
-                else:
-                    break
-            keys[i] = kk
-            nodes[i] = nn
+        u, size = heap_pop(keys, nodes, size)
         if closed[u]:
             continue
         closed[u] = True
@@ -164,21 +144,8 @@ def _search(occ, mult, sr, sc, gr, gc, corner_cutting, max_exp, keys, nodes):
                 if ng < g[v]:
                     g[v] = ng
                     parent[v] = u
-                    if size >= keys.shape[0]:
-                        return g, parent, 3, exp  # heap full: the caller grows it
-                    f = ng + math.hypot(vr - gr, vc - gc)
-                    i = size
-                    size += 1
-                    while i > 0:
-                        up = (i - 1) >> 1
-                        if f < keys[up]:
-                            keys[i] = keys[up]
-                            nodes[i] = nodes[up]
-                            i = up
-                        else:
-                            break
-                    keys[i] = f
-                    nodes[i] = v
+                    keys, nodes, size = heap_push(keys, nodes, size,
+                                                  ng + math.hypot(vr - gr, vc - gc), v)
     return g, parent, 1, exp
 
 
@@ -192,15 +159,8 @@ def costaware_search(occ: np.ndarray, mult: np.ndarray, start: tuple[int, int],
     ``cost_cells`` the path's cost in cell sides.
     """
     cap = int(max_expansions) if max_expansions is not None else occ.size + 1
-    size = 1 << 12
-    while True:
-        keys = np.empty(size)
-        nodes = np.empty(size, dtype=np.int64)
-        g, parent, code, exp = _search(occ, mult, start[0], start[1], goal[0], goal[1],
-                                       bool(corner_cutting), cap, keys, nodes)
-        if code != 3:
-            break
-        size *= 4
+    g, parent, code, exp = _search(occ, mult, start[0], start[1], goal[0], goal[1],
+                                   bool(corner_cutting), cap)
     if code != 0:
         return code, np.zeros((0, 2), dtype=np.int64), math.inf, exp
     w = occ.shape[1]

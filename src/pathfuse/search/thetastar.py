@@ -49,6 +49,8 @@ import numpy as np
 from numba import njit
 
 from pathfuse.result import Status
+from pathfuse.search.heap import heap_pop as _pop
+from pathfuse.search.heap import heap_push as _push
 from pathfuse.search.los import line_of_sight
 
 __all__ = ["AnyAngleResult", "theta_star", "warmup"]
@@ -93,53 +95,6 @@ def _pos(node, w, snode, sx, sy, gnode, gx, gy, ox, oy, res):
     r = node // w
     c = node - r * w
     return ox + (c + 0.5) * res, oy + (r + 0.5) * res
-
-
-@njit(cache=True, inline="always")
-def _push(hkey, hnode, size, key, node):
-    if size >= hkey.shape[0]:
-        nk = np.empty(2 * hkey.shape[0])
-        nn = np.empty(2 * hkey.shape[0], dtype=np.int64)
-        for j in range(size):
-            nk[j] = hkey[j]
-            nn[j] = hnode[j]
-        hkey = nk
-        hnode = nn
-    i = size
-    while i > 0:
-        p = (i - 1) >> 1
-        if hkey[p] <= key:
-            break
-        hkey[i] = hkey[p]
-        hnode[i] = hnode[p]
-        i = p
-    hkey[i] = key
-    hnode[i] = node
-    return hkey, hnode, size + 1
-
-
-@njit(cache=True, inline="always")
-def _pop(hkey, hnode, size):
-    top = hnode[0]
-    size -= 1
-    key = hkey[size]
-    node = hnode[size]
-    i = 0
-    while True:
-        c = 2 * i + 1
-        if c >= size:
-            break
-        if c + 1 < size and hkey[c + 1] < hkey[c]:
-            c += 1
-        if hkey[c] >= key:
-            break
-        hkey[i] = hkey[c]
-        hnode[i] = hnode[c]
-        i = c
-    if size > 0:
-        hkey[i] = key
-        hnode[i] = node
-    return top, size
 
 
 @njit(cache=True, inline="always")

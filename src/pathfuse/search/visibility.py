@@ -66,7 +66,9 @@ from numba import njit
 
 from pathfuse.geometry import MARGIN_FRAC, _segment_hits_box
 from pathfuse.result import Status
-from pathfuse.search.thetastar import AnyAngleResult, _pop, _push
+from pathfuse.search.heap import heap_pop as _pop
+from pathfuse.search.heap import heap_push as _push
+from pathfuse.search.thetastar import AnyAngleResult
 
 __all__ = ["shortest_path", "convex_corners", "segment_admissible", "growth_cells", "warmup"]
 

@@ -98,10 +98,11 @@ def _address(client: Any) -> str:
         return "the Dask scheduler"
 
 
-def _lost(client: Any, why: str) -> ClusterLost:
-    return ClusterLost(f"lost the Dask scheduler at {_address(client)} ({why}); the runs "
-                       "that finished are stored, run the same command again to finish the "
-                       "rest")
+def _lost(client: Any) -> ClusterLost:
+    # one wording, whichever sign of the loss came first (a cancelled future, the client
+    # reconnecting, a failed call): which one wins is a matter of timing
+    return ClusterLost(f"lost the Dask scheduler at {_address(client)}; the runs that "
+                       "finished are stored, run the same command again to finish the rest")
 
 
 class _Watch:
@@ -115,11 +116,11 @@ class _Watch:
 
     def workers(self) -> int:
         if getattr(self.client, "status", "running") != "running":
-            raise _lost(self.client, f"client {self.client.status}")
+            raise _lost(self.client)
         try:
             info = self.client.scheduler_info()
-        except (OSError, TimeoutError) as exc:
-            raise _lost(self.client, type(exc).__name__) from None
+        except (OSError, TimeoutError):
+            raise _lost(self.client) from None
         return len(info.get("workers", {}))
 
     def check(self) -> None:
@@ -149,6 +150,17 @@ class _Watch:
                 "kept)")
 
 
+def _result(f: Any, watch: _Watch) -> Any:
+    """``f.result()``, checking the cluster while it waits: a finished task whose worker dies
+    before its result is fetched is queued again, and with no worker left a plain
+    ``result()`` would wait forever."""
+    while True:
+        try:
+            return f.result(timeout=_CHECK_EVERY_S)
+        except TimeoutError:
+            watch.check()
+
+
 def _drain(client: Any, futures: Sequence[Any], watch: _Watch, handle: Any) -> None:
     """Hand each future to ``handle`` as it completes, checking the cluster while waiting."""
     from distributed import as_completed  # type: ignore[import-not-found]
@@ -158,8 +170,7 @@ def _drain(client: Any, futures: Sequence[Any], watch: _Watch, handle: Any) -> N
         if ac.has_ready():
             for f in ac.next_batch(block=False):
                 if f.status == "cancelled":
-                    why = getattr(f._state.exception, "reason", None) or "futures cancelled"
-                    raise _lost(client, str(why))
+                    raise _lost(client)
                 handle(f)
         else:
             watch.check()
@@ -203,7 +214,7 @@ def run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: DaskSink, scheduler
         def batch_done(f: Any) -> None:
             b = index.pop(f)
             try:
-                sink.write(f.result())
+                sink.write(_result(f, watch))
             except KilledWorker:
                 singles.extend(r for c in b for r in c)
             except CancelledError:
@@ -226,7 +237,7 @@ def run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: DaskSink, scheduler
             def single_done(f: Any) -> None:
                 r = single_index.pop(f)
                 try:
-                    sink.write(f.result())
+                    sink.write(_result(f, watch))
                 except KilledWorker:
                     sink.write([_crash_row(r)])
                 except CancelledError:
@@ -236,9 +247,8 @@ def run_dask(exp: Experiment, todo: Sequence[RunSpec], sink: DaskSink, scheduler
 
             _drain(client, fs, watch, single_done)
         return nworkers
-    except CancelledError as exc:  # a future cancelled between the check and its result
-        raise _lost(client, str(getattr(exc, "reason", None) or "futures cancelled")) \
-            from None
+    except CancelledError:  # a future cancelled between the check and its result
+        raise _lost(client) from None
     finally:
         try:
             client.cancel(futures)

@@ -18,7 +18,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "pathfuse"
 # low -> high; a module may import its own layer and the layers below it
 LAYERS: list[tuple[str, ...]] = [
     ("_version", "result", "validate", "limits", "safeyaml"),
-    ("grid", "geometry", "problem", "stats", "robot", "sweep"),
+    ("grid", "geometry", "problem", "stats", "robot", "sweep", "shield"),
     ("search", "field", "io", "generate", "metrics", "metrics_kernels"),
     ("planners", "api"),
     ("world",),

@@ -83,6 +83,11 @@ class RobotModel:
         The soft safety margin beyond the radius (>= 0; 0 = off).
     heading_rad : float or None
         Initial heading (None: facing the goal).
+    shield : bool
+        Online, pass every command through the safety shield
+        (:mod:`pathfuse.shield`, ours): a command is executed only when the
+        robot could still stop clear of the static map after it.  True by
+        default; False runs the controllers' commands as they are.
     """
 
     kind: str = "holonomic"
@@ -95,6 +100,7 @@ class RobotModel:
     min_speed_mps: float = 0.0
     clearance_m: float = 0.0
     heading_rad: float | None = None
+    shield: bool = True
 
     def __post_init__(self) -> None:
         validate.choice(self.kind, "robot.kind", KINDS)
@@ -111,6 +117,7 @@ class RobotModel:
         validate.number(self.clearance_m, "robot.clearance_m", ge=0)
         if self.heading_rad is not None:
             validate.number(self.heading_rad, "robot.heading_rad")
+        validate.flag(self.shield, "robot.shield")
         if self.kind == "holonomic" and self.min_speed_mps != 0:
             raise ConfigError("robot.min_speed_mps: a holonomic robot has no reverse speed "
                               f"(a velocity vector); got {self.min_speed_mps!r}")

@@ -24,10 +24,12 @@ def _metric_kernels() -> list:
 
 
 def _world_kernels() -> list:
+    from pathfuse import shield
     from pathfuse.world import geometry, obstacles
 
     return [obstacles._clear, obstacles._bounce_trajectory, geometry.disc_sweep_gaps,
-            geometry.segment_static_distance]
+            geometry.segment_static_distance, shield.shield_unicycle,
+            shield.shield_holonomic]
 
 
 def cold_kernels_of(planners: Iterable[str], metrics: bool = True,
@@ -69,9 +71,11 @@ def warm_kernels(planners: Iterable[str], metrics: bool = True, world: bool = Fa
 
         warmup()
     if world:
+        from pathfuse.shield import warmup_shield
         from pathfuse.world.geometry import warmup_geometry
         from pathfuse.world.obstacles import warmup_obstacles
 
         warmup_geometry()
         warmup_obstacles()
+        warmup_shield()
     return cold

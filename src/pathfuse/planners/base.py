@@ -137,6 +137,10 @@ class Controller:
         self.online = dt is not None
         self._global_path: np.ndarray | None = None
         self.failure: tuple[Status, str] | None = None
+        #: Online: how many commands the shield passed, replaced by a nearby one, replaced
+        #: by the emergency stop, found no clear command for, or evaded a disc with
+        #: (indexed by :data:`pathfuse.shield.CODE_NAMES`).
+        self.shield_counts = np.zeros(5, dtype=np.int64)
 
     @property
     def global_path(self) -> np.ndarray | None:
@@ -159,18 +163,61 @@ class Controller:
         raise NotImplementedError
 
     def command(self, obs: Observed) -> np.ndarray:
-        """The action for this tick in the robot's terms: :meth:`act`'s velocity for a
-        holonomic robot, ``(v, omega)`` for a diff-drive one (converted by
-        :func:`pathfuse.planners.drive.to_unicycle` unless the controller plans in
-        ``(v, omega)`` itself)."""
+        """The action for this tick in the robot's terms, through the safety shield.
+
+        :meth:`act`'s velocity for a holonomic robot, ``(v, omega)`` for a
+        diff-drive one (converted by :func:`pathfuse.planners.drive.to_unicycle`
+        unless the controller plans in ``(v, omega)`` itself); then, unless the
+        robot's ``shield`` is off, :mod:`pathfuse.shield` replaces it with the
+        nearest command from which the robot can still stop clear of the static
+        map (:attr:`shield_counts` counts what it did).
+        """
         a = self.act(obs)
         rb = self.problem.robot
-        if rb is None or not rb.is_diff_drive or self.native_unicycle:
+        if rb is None:
             return a
-        from pathfuse.planners.drive import to_unicycle
+        if rb.is_diff_drive and not self.native_unicycle:
+            from pathfuse.planners.drive import to_unicycle
 
-        return to_unicycle(self.problem, rb, float(self.dt), obs,  # type: ignore[arg-type]
-                           a)
+            a = to_unicycle(self.problem, rb, float(self.dt),  # type: ignore[arg-type]
+                            obs, a)
+        if not rb.shield:
+            return a
+        return self._shielded(obs, a)
+
+    def _shielded(self, obs: Observed, a: np.ndarray) -> np.ndarray:
+        from pathfuse.geometry import MARGIN_FRAC
+        from pathfuse.shield import shield_holonomic, shield_unicycle
+
+        pb = self.problem
+        rb = pb.robot
+        assert rb is not None
+        g = pb.grid
+        ox, oy = float(g.origin[0]), float(g.origin[1])
+        res = float(g.resolution)
+        clear = float(pb.robot_radius_m) + MARGIN_FRAC * res
+        sens = obs.obstacles
+        if len(sens):
+            dp, dv, dr = _plain(sens.positions), _plain(sens.velocities), _plain(sens.radii)
+        else:
+            dp, dv, dr = _NO_DISCS
+        cmd = obs.command
+        dt = float(self.dt)  # type: ignore[arg-type]
+        if rb.is_diff_drive:
+            u, w, code = shield_unicycle(
+                g.occupied, ox, oy, res, float(obs.position[0]), float(obs.position[1]),
+                float(obs.heading), float(cmd[0]), float(cmd[1]), float(a[0]), float(a[1]),
+                dt, rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2,
+                rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2, clear,
+                float(pb.robot_radius_m), dp, dv, dr, 0.0)
+        else:
+            u, w, code = shield_holonomic(
+                g.occupied, ox, oy, res, float(obs.position[0]), float(obs.position[1]),
+                float(cmd[0]), float(cmd[1]), float(a[0]), float(a[1]), dt,
+                float(self.max_speed if self.max_speed is not None else rb.max_speed_mps),
+                rb.max_accel_mps2, clear, float(pb.robot_radius_m), dp, dv, dr, 0.0)
+        self.shield_counts[code] += 1
+        return np.array([u, w])
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:

@@ -248,6 +248,9 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
     problem = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius,
                              clearance_m=sc.robot.clearance, robot=model)
     warm(spec)
+    from pathfuse.shield import warmup_shield
+
+    warmup_shield()  # the world's clip and the shield
     if model.is_diff_drive:
         from pathfuse.planners.drive import warmup_drive
         from pathfuse.sweep import warmup_sweep

@@ -17,7 +17,7 @@ from pathfuse.robot import KINDS, RobotModel
 __all__ = ["RobotSpec", "parse_robot", "ROBOT_KEYS"]
 
 ROBOT_KEYS = ("radius", "max_speed", "sensing_radius", "model", "max_accel", "max_yaw_rate",
-              "max_yaw_accel", "min_speed", "clearance", "heading")
+              "max_yaw_accel", "min_speed", "clearance", "heading", "shield")
 """The keys of a ``robot:`` block."""
 
 
@@ -53,6 +53,9 @@ class RobotSpec:
         Soft safety margin beyond the radius (m; ours; 0 = off).
     heading : float or None
         Initial heading (rad; None: facing the goal).
+    shield : bool
+        Pass every command through the safety shield (ours; default true;
+        :mod:`pathfuse.shield`).
     """
 
     radius: float = 0.2
@@ -65,13 +68,14 @@ class RobotSpec:
     min_speed: float = 0.0
     clearance: float = 0.0
     heading: float | None = None
+    shield: bool = True
 
     def to_model(self) -> RobotModel:
         """The :class:`~pathfuse.robot.RobotModel` of this block (defaults filled in)."""
         kw: dict[str, Any] = {"radius_m": self.radius, "max_speed_mps": self.max_speed,
                               "sensing_radius_m": self.sensing_radius,
                               "min_speed_mps": self.min_speed, "clearance_m": self.clearance,
-                              "heading_rad": self.heading}
+                              "heading_rad": self.heading, "shield": self.shield}
         for key, attr in (("max_accel_mps2", "max_accel"),
                           ("max_yaw_rate_radps", "max_yaw_rate"),
                           ("max_yaw_accel_radps2", "max_yaw_accel")):
@@ -92,7 +96,7 @@ class RobotSpec:
                    sensing_radius=m.sensing_radius_m, model=m.kind,
                    max_accel=lim(m.max_accel_mps2), max_yaw_rate=lim(m.max_yaw_rate_radps),
                    max_yaw_accel=lim(m.max_yaw_accel_radps2), min_speed=m.min_speed_mps,
-                   clearance=m.clearance_m, heading=m.heading_rad)
+                   clearance=m.clearance_m, heading=m.heading_rad, shield=m.shield)
 
 
 def parse_robot(v: Any, error: type[ConfigError] = ConfigError) -> RobotSpec:
@@ -122,4 +126,5 @@ def parse_robot(v: Any, error: type[ConfigError] = ConfigError) -> RobotSpec:
         min_speed=num("min_speed", le=0),
         clearance=num("clearance", ge=0),
         heading=opt("heading"),
+        shield=validate.flag(m.get("shield", d.shield), "robot.shield", error),
     )

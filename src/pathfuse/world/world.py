@@ -83,6 +83,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.result import PathfuseError, QueryError
+from pathfuse.shield import clip_holonomic, clip_unicycle
 from pathfuse.sweep import arc_disc_gaps, arc_static_distance, unicycle_pose
 from pathfuse.validate import short as _shown
 from pathfuse.world.geometry import (
@@ -284,28 +285,16 @@ class World:
             raise QueryError(f"action must be finite {what}, got {_shown(action)}")
         rb = self.robot
         dt = self.dt
+        lin, ang = float(v[0]), float(v[1])
         if self.diff_drive:
-            c0 = self.command
-            lin, ang = float(v[0]), float(v[1])
-            lo = max(rb.min_speed_mps, c0[0] - rb.max_accel_mps2 * dt)
-            hi = min(rb.max_speed_mps, c0[0] + rb.max_accel_mps2 * dt)
-            wlo = max(-rb.max_yaw_rate_radps, c0[1] - rb.max_yaw_accel_radps2 * dt)
-            whi = min(rb.max_yaw_rate_radps, c0[1] + rb.max_yaw_accel_radps2 * dt)
-            out = np.array([min(max(lin, lo), hi), min(max(ang, wlo), whi)])
-            return out, bool(out[0] != lin or out[1] != ang)
-        clipped = False
-        s = math.hypot(v[0], v[1])
-        if s > self.max_speed:
-            v = v * (self.max_speed / s)
-            clipped = True
-        if not math.isinf(rb.max_accel_mps2):
-            dv = v - self.velocity
-            lim = rb.max_accel_mps2 * dt
-            n = math.hypot(dv[0], dv[1])
-            if n > lim * (1.0 + 1e-9):  # beyond rounding
-                v = self.velocity + dv * (lim / n)
-                clipped = True
-        return v, clipped
+            a, b = clip_unicycle(float(self.command[0]), float(self.command[1]), lin, ang, dt,
+                                 rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2,
+                                 rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2)
+        else:
+            a, b = clip_holonomic(float(self.velocity[0]), float(self.velocity[1]), lin, ang,
+                                  dt, self.max_speed, rb.max_accel_mps2)
+        out = np.array([a, b])
+        return out, bool(a != lin or b != ang)
 
     def step(self, action: Any) -> tuple[Observation, bool, bool, dict[str, Any]]:
         """Move the robot with velocity ``action`` for one tick and the discs with it.

@@ -17,6 +17,7 @@ from pathfuse.planners.drive import admissible
 from pathfuse.problem import Problem
 from pathfuse.shield import (
     ASKED,
+    EVADE,
     NEAREST,
     UNSAFE,
     holonomic_stop_clear,
@@ -151,28 +152,36 @@ def test_shield_codes():
     z2, z1 = np.zeros((0, 2)), np.zeros(0)
     lim = (0.0, 1.0, 1.0, 2.0, 4.0)
     v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, z2, z2, z1, 0.0)
+                                 *lim, 0.3, 0.3, z2, z1, z1, 0.0)
     assert (v, w, code) == (1.0, 0.0, ASKED)
     # facing the wall at full speed, 0.4 m from it: brake (and turn away)
     v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 5.3, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, z2, z2, z1, 0.0)
+                                 *lim, 0.3, 0.3, z2, z1, z1, 0.0)
     assert code == NEAREST and v < 1.0
     assert unicycle_stop_clear(occ, 0.0, 0.0, 1.0, 5.3, 5.0, 0.0, v, w, 0.5, 1.0, 4.0, 0.3)
     # too close already: no clear command exists; the emergency stop is returned
     v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 5.5, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, z2, z2, z1, 0.0)
+                                 *lim, 0.3, 0.3, z2, z1, z1, 0.0)
     assert code == UNSAFE and v == 0.5
-    # a disc coming head-on: the straight command would meet it while moving; the nearest
-    # command that keeps a predicted gap is taken instead
-    dp, dv, dr = np.array([[4.0, 5.0]]), np.array([[-1.0, 0.0]]), np.array([0.3])
-    gap = unicycle_stop_disc_gap(2.0, 5.0, 0.0, 1.0, 0.0, 0.5, 1.0, 4.0, 0.3, dp, dv, dr)
+    # a disc 2 m ahead that may come at 1 m/s: going on at 1 m/s, the robot could not stop
+    # before the disc can reach it; the shield brakes and turns away until it can
+    dp, ds, dr = np.array([[4.0, 5.0]]), np.array([1.0]), np.array([0.3])
+    gap = unicycle_stop_disc_gap(2.0, 5.0, 0.0, 1.0, 0.0, 0.5, 1.0, 4.0, 0.3, dp, ds, dr)
     assert gap < 0
     v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, dp, dv, dr, 0.0)
-    assert code == NEAREST and w != 0.0
-    assert unicycle_stop_disc_gap(2.0, 5.0, 0.0, v, w, 0.5, 1.0, 4.0, 0.3, dp, dv, dr) >= 0
+                                 *lim, 0.3, 0.3, dp, ds, dr, 0.0)
+    assert code == NEAREST and v < 1.0 and w != 0.0
+    assert unicycle_stop_disc_gap(2.0, 5.0, 0.0, v, w, 0.5, 1.0, 4.0, 0.3, dp, ds, dr) >= 0
+    # 1.2 m ahead no stop can keep clear of where it may be: the largest gap (evade)
+    v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
+                                 *lim, 0.3, 0.3, dp - [0.8, 0.0], ds, dr, 0.0)
+    assert code == EVADE and v == 0.5
+    # far enough away, the asked command passes
+    v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
+                                 *lim, 0.3, 0.3, dp + [0.0, 3.0], ds, dr, 0.0)
+    assert code == ASKED
     ux, uy, code = shield_holonomic(occ, 0.0, 0.0, 1.0, 5.5, 5.0, 0.0, 0.0, 1.0, 0.0, 0.5, 1.0,
-                                    math.inf, 0.3, 0.3, z2, z2, z1, 0.0)
+                                    math.inf, 0.3, 0.3, z2, z1, z1, 0.0)
     assert code == NEAREST and 5.5 + ux * 0.5 + 0.3 <= 6.0
 
 
@@ -284,3 +293,60 @@ def test_the_adversary_does_collide_without_the_shield():
             if out is not None and out[0] < -1e-6:
                 hits += 1
     assert hits >= 20
+
+
+def _crowd_episode(seed, diff, shield=True, n_ticks=120):
+    """An open hall with random walkers that may turn anywhere at any tick, an adversarial
+    controller, every disc sensed."""
+    rng = np.random.default_rng(seed)
+    robot = {"model": "diff-drive" if diff else "holonomic", "radius": 0.25,
+             "max_speed": float(rng.uniform(0.5, 2.0)), "max_accel": float(rng.uniform(0.5, 3)),
+             "sensing_radius": 100.0, "shield": shield}
+    if diff:
+        robot.update(max_yaw_rate=2.0, max_yaw_accel=4.0)
+    obstacles = []
+    start = np.array([6.0, 6.0])
+    while len(obstacles) < int(rng.integers(2, 7)):
+        p = rng.uniform(0.6, 11.4, 2)
+        r = float(rng.uniform(0.2, 0.5))
+        if np.hypot(*(p - start)) < 0.25 + r + 0.3:
+            continue
+        obstacles.append({"random_walk": {"position": p.tolist(),
+                                          "speed": float(rng.uniform(0.2, 1.5)),
+                                          "seed": int(rng.integers(1 << 30)),
+                                          "turn_std": float(rng.uniform(0.5, 6.0))},
+                          "radius": r})
+    sc = {"map": {"rows": ["." * 12] * 12}, "start": start.tolist(), "goal": [11.5, 11.5],
+          "goal_tolerance": 1e-9, "robot": robot, "dt": 0.1, "time_limit": 1000,
+          "obstacles": obstacles}
+    world = World(sc)
+    obs = world.reset(seed)
+    problem = Problem.create(world.scenario.grid, tuple(start), (11.5, 11.5), 0.25,
+                             robot=world.robot)
+    ctrl = Adversary(problem, seed, dt=world.dt, max_speed=world.robot.max_speed_mps)
+    for _ in range(n_ticks):
+        if len(obs.obstacles) and rng.random() < 0.5:  # chase the nearest walker
+            d = obs.obstacles.positions - obs.position
+            k = int(np.argmin(np.hypot(d[:, 0], d[:, 1])))
+            ctrl.targets = obs.obstacles.positions[k:k + 1]
+        obs, term, trunc, info = world.step(ctrl.command(obs))
+        if term:
+            return info
+    return None
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**32 - 1), diff=st.booleans())
+def test_passive_safety_among_walkers_that_turn_anywhere(seed, diff):
+    """Walkers keep their speed but may turn at any tick; the shielded robot may be walked
+    into, but it is never moving when a contact happens."""
+    info = _crowd_episode(seed, diff)
+    if info is not None and info["event"] == "collision":
+        assert info["at_fault"] is False, (seed, diff, info)
+
+
+def test_the_walker_chase_is_the_robots_fault_without_the_shield():
+    faults = sum(1 for seed in range(30) for diff in (True, False)
+                 if (info := _crowd_episode(seed, diff, shield=False)) is not None
+                 and info["at_fault"])
+    assert faults >= 20

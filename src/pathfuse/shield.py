@@ -35,15 +35,19 @@ command, and a robot that starts clear never touches the static map.
 ``tests/test_shield.py`` checks it with hypothesis against a brute-force
 simulation of the unicycle, with random and adversarial controllers.
 
-Moving discs (best effort; the guarantee is *passive safety*)
-    The sensed discs are predicted at their present velocity.  A command is
-    preferred when, while the robot is moving (the command's tick and its
-    stop), the predicted gap to every disc stays above ``disc_margin``; if no
-    statically clear command achieves that, the statically clear one with
-    the largest predicted gap is taken (evade).  A disc may still walk into
-    a robot standing still (people and robots that do not react); a contact
-    while the robot moves is the robot's fault, and the benchmarks count
-    those apart.
+Moving discs (*passive safety*: the robot is at rest whenever a disc reaches it)
+    A disc may turn at any moment but not go faster than its speed bound
+    ``dspeed`` (the caller's: :meth:`Controller.command
+    <pathfuse.planners.base.Controller.command>` passes the fastest speed it
+    has observed for that disc), so at time ``t`` it lies within ``dspeed t``
+    of where it is now.  A command is preferred when, while the robot moves
+    (the command's tick and its stop), it keeps a gap of at least
+    ``disc_margin`` to those growing discs: then, whatever the discs do
+    within their bounds, the robot is standing still before any can touch it.
+    If no statically clear command achieves that, the statically clear one
+    with the largest such gap is taken (evade).  A disc may still walk into a
+    robot standing still: a contact while the robot moves is the robot's
+    fault, and the benchmarks count those apart.
 
 The return code says what happened: :data:`ASKED` (the command passed),
 :data:`NEAREST` (replaced by a nearby safe command), :data:`EMERGENCY` (the
@@ -62,7 +66,7 @@ Examples
 >>> bool(unicycle_stop_clear(occ, 0.0, 0.0, 1.0, 5.0, 5.0, 0.0, 1.0, 0.0, 0.5, 1.0, 4.0, 0.3))
 False
 >>> v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 5.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0,
-...                              0.5, 0.0, 1.0, 1.0, 2.0, 4.0, 0.3, 0.3, z2, z2, z1, 0.0)
+...                              0.5, 0.0, 1.0, 1.0, 2.0, 4.0, 0.3, 0.3, z2, z1, z1, 0.0)
 >>> round(v, 6), round(w, 6), CODE_NAMES[code]   # the nearest command that can still stop
 (0.916667, 0.0, 'nearest')
 """
@@ -197,20 +201,21 @@ def holonomic_stop_clear(occ: np.ndarray, ox: float, oy: float, res: float, x: f
 @njit(cache=True)
 def unicycle_stop_disc_gap(x: float, y: float, th: float, v: float, w: float, dt: float,
                            amax: float, alpha: float, radius: float, dpos: np.ndarray,
-                           dvel: np.ndarray, drad: np.ndarray) -> float:
-    """The least predicted gap to the discs (constant velocity) while the robot moves over
-    the command's tick and its stop (``inf`` without discs or when it does not move)."""
+                           dspeed: np.ndarray, drad: np.ndarray) -> float:
+    """The least gap, while the robot moves over the command's tick and its stop, to the
+    places the discs can reach: disc ``i`` anywhere within ``dspeed[i] t`` of where it is
+    now (``inf`` without discs or when the robot does not move)."""
     best = np.inf
     if dpos.shape[0] == 0:
         return best
     n = _stop_ticks(v, amax, dt)
+    reach = np.empty(drad.shape[0])
     for k in range(n):
         if v == 0.0:
             break
-        q0 = dpos + dvel * (k * dt)
-        q1 = dpos + dvel * ((k + 1) * dt)
-        g = arc_disc_gaps(x, y, th, v, w, dt, radius, q0, q1, drad)
-        m = g.min()
+        for i in range(drad.shape[0]):
+            reach[i] = drad[i] + dspeed[i] * ((k + 1) * dt)
+        m = arc_disc_gaps(x, y, th, v, w, dt, radius, dpos, dpos, reach).min()
         if m < best:
             best = m
         x, y, th = unicycle_pose(x, y, th, v, w, dt)
@@ -221,7 +226,7 @@ def unicycle_stop_disc_gap(x: float, y: float, th: float, v: float, w: float, dt
 
 @njit(cache=True)
 def holonomic_stop_disc_gap(x: float, y: float, ux: float, uy: float, dt: float, amax: float,
-                            radius: float, dpos: np.ndarray, dvel: np.ndarray,
+                            radius: float, dpos: np.ndarray, dspeed: np.ndarray,
                             drad: np.ndarray) -> float:
     """As :func:`unicycle_stop_disc_gap` for the holonomic robot's straight stop."""
     best = np.inf
@@ -231,16 +236,17 @@ def holonomic_stop_disc_gap(x: float, y: float, ux: float, uy: float, dt: float,
     n = _stop_ticks(s, amax, dt)
     p0 = np.empty(2)
     p1 = np.empty(2)
+    reach = np.empty(drad.shape[0])
     for k in range(n):
         if s == 0.0:
             break
-        q0 = dpos + dvel * (k * dt)
-        q1 = dpos + dvel * ((k + 1) * dt)
+        for i in range(drad.shape[0]):
+            reach[i] = drad[i] + dspeed[i] * ((k + 1) * dt)
         p0[0], p0[1] = x, y
         x = x + ux * dt
         y = y + uy * dt
         p1[0], p1[1] = x, y
-        m = disc_sweep_gaps(p0, p1, radius, q0, q1, drad).min()
+        m = disc_sweep_gaps(p0, p1, radius, dpos, dpos, reach).min()
         if m < best:
             best = m
         ns = _toward_zero(s, amax * dt)
@@ -264,7 +270,7 @@ def _here_clear(occ, ox, oy, res, x, y, clear):
 def shield_unicycle(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
                     th: float, v0: float, w0: float, v: float, w: float, dt: float,
                     vmin: float, vmax: float, amax: float, wmax: float, alpha: float,
-                    clear: float, radius: float, dpos: np.ndarray, dvel: np.ndarray,
+                    clear: float, radius: float, dpos: np.ndarray, dspeed: np.ndarray,
                     drad: np.ndarray, disc_margin: float, nv: int = 7,
                     nw: int = 9) -> tuple[float, float, int]:
     """The shielded diff-drive command ``(v, w, code)`` (see the module docstring).
@@ -272,7 +278,7 @@ def shield_unicycle(occ: np.ndarray, ox: float, oy: float, res: float, x: float,
     ``(x, y, th)`` is the pose, ``(v0, w0)`` the last applied command,
     ``(v, w)`` the controller's; ``clear`` the static clearance to keep
     (the radius plus a hair), ``radius`` the disc for the moving discs'
-    gaps; ``dpos``, ``dvel``, ``drad`` the sensed discs.
+    gaps; ``dpos``, ``dspeed``, ``drad`` the sensed discs' centres, speed bounds and radii.
     """
     clear = _here_clear(occ, ox, oy, res, x, y, clear)
     v, w = clip_unicycle(v0, w0, v, w, dt, vmin, vmax, amax, wmax, alpha)
@@ -280,7 +286,7 @@ def shield_unicycle(occ: np.ndarray, ox: float, oy: float, res: float, x: float,
     if unicycle_stop_clear(occ, ox, oy, res, x, y, th, v, w, dt, amax, alpha, clear):
         if nd == 0:
             return v, w, ASKED
-        g = unicycle_stop_disc_gap(x, y, th, v, w, dt, amax, alpha, radius, dpos, dvel, drad)
+        g = unicycle_stop_disc_gap(x, y, th, v, w, dt, amax, alpha, radius, dpos, dspeed, drad)
         if g >= disc_margin:
             return v, w, ASKED
         best_g, best_v, best_w = g, v, w
@@ -322,7 +328,7 @@ def shield_unicycle(occ: np.ndarray, ox: float, oy: float, res: float, x: float,
         code = EMERGENCY if k == m else NEAREST
         if nd == 0:
             return vk, wk, code
-        g = unicycle_stop_disc_gap(x, y, th, vk, wk, dt, amax, alpha, radius, dpos, dvel,
+        g = unicycle_stop_disc_gap(x, y, th, vk, wk, dt, amax, alpha, radius, dpos, dspeed,
                                    drad)
         if g >= disc_margin:
             return vk, wk, code
@@ -338,7 +344,7 @@ def shield_unicycle(occ: np.ndarray, ox: float, oy: float, res: float, x: float,
 def shield_holonomic(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
                      ux0: float, uy0: float, ux: float, uy: float, dt: float, vmax: float,
                      amax: float, clear: float, radius: float, dpos: np.ndarray,
-                     dvel: np.ndarray, drad: np.ndarray, disc_margin: float,
+                     dspeed: np.ndarray, drad: np.ndarray, disc_margin: float,
                      nd: int = 12) -> tuple[float, float, int]:
     """The shielded holonomic velocity ``(ux, uy, code)``: the asked velocity, else the
     nearest of ``nd`` directions x 4 speeds (each clipped as the world clips), else the
@@ -349,7 +355,7 @@ def shield_holonomic(occ: np.ndarray, ox: float, oy: float, res: float, x: float
     if holonomic_stop_clear(occ, ox, oy, res, x, y, ux, uy, dt, amax, clear):
         if ndisc == 0:
             return ux, uy, ASKED
-        g = holonomic_stop_disc_gap(x, y, ux, uy, dt, amax, radius, dpos, dvel, drad)
+        g = holonomic_stop_disc_gap(x, y, ux, uy, dt, amax, radius, dpos, dspeed, drad)
         if g >= disc_margin:
             return ux, uy, ASKED
         best_g, best_x, best_y = g, ux, uy
@@ -392,7 +398,7 @@ def shield_holonomic(occ: np.ndarray, ox: float, oy: float, res: float, x: float
         code = EMERGENCY if k == m else NEAREST
         if ndisc == 0:
             return px, py, code
-        g = holonomic_stop_disc_gap(x, y, px, py, dt, amax, radius, dpos, dvel, drad)
+        g = holonomic_stop_disc_gap(x, y, px, py, dt, amax, radius, dpos, dspeed, drad)
         if g >= disc_margin:
             return px, py, code
         if not found or g > best_g:
@@ -411,7 +417,7 @@ def warmup_shield() -> None:
         occ[1, 1] = True
         d2 = np.zeros((1, 2))
         d2[0] = (2.5, 2.5)
-        v2 = np.zeros((1, 2))
+        v2 = np.full(1, 0.5)
         r1 = np.full(1, 0.1)
         occ.setflags(write=not ro)
         for a in (d2, v2, r1):

@@ -427,7 +427,10 @@ def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
     tick's ``plan_times_s``); ``time_to_goal`` the simulated time to reach
     the goal; ``solution_length`` the driven trajectory's length (reached
     episodes); ``solution_clearance`` the least clearance to any obstacle;
-    ``collisions`` 1 when the episode ended in a collision.
+    ``collisions`` 1 when the episode ended in a collision.  ``metrics`` holds the
+    episode's scalar values, with ``collision_at_fault`` and the safety shield's
+    counts (``shield_asked``, ``shield_nearest``, ``shield_emergency``,
+    ``shield_unsafe``, ``shield_evade``).
     """
     status = ep.status
     name = str(getattr(status, "name", status)).upper()
@@ -460,7 +463,7 @@ def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
     timing = {k: v for k, v in _scalars(sc_d).items() if _is_timing(k) and "to_goal" not in k}
     names = {} if sc is None else {"scenario": str(sc.name), "map": str(sc.grid.name)}
     row["metrics"] = json.dumps({**{k: v for k, v in _scalars(sc_d).items() if k not in timing},
-                                 **names}, sort_keys=True)
+                                 **_episode_extras(ep), **names}, sort_keys=True)
     row["timing"] = json.dumps(timing, sort_keys=True)
     if store_paths and positions.shape[0]:
         row["path"] = _path_blob(positions)
@@ -468,6 +471,21 @@ def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
         if headings.shape[0] == positions.shape[0]:
             row["headings"] = np.ascontiguousarray(headings, dtype="<f8").tobytes()
     return row
+
+
+def _episode_extras(ep: Any) -> dict[str, Any]:
+    """The episode's values that are not plain scalars of its dict, for ``metrics``:
+    ``collision_at_fault`` (true, false, or null without a collision) and the shield
+    counts as ``shield_<name>`` (:data:`pathfuse.shield.CODE_NAMES`).  An episode
+    without them (older code) adds nothing, and readers show n/a."""
+    out: dict[str, Any] = {}
+    if hasattr(ep, "collision_at_fault"):
+        v = ep.collision_at_fault
+        out["collision_at_fault"] = None if v is None else bool(v)
+    counts = getattr(ep, "shield_counts", None) or {}
+    for name, k in counts.items():
+        out[f"shield_{name}"] = int(k)
+    return out
 
 
 KINDS: dict[str, Callable[[Mapping[str, Any], Mapping[str, Any], bool], dict[str, Any]]] = {

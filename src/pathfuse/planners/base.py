@@ -125,7 +125,8 @@ class Controller:
     controller's moves."""
     native_unicycle: ClassVar[bool] = False
     """Whether :meth:`act` answers ``(v, omega)`` itself on a diff-drive robot (``dwa``);
-    otherwise :meth:`command` converts its velocity (:mod:`pathfuse.planners.drive`)."""
+    otherwise :meth:`command` converts its velocity (:mod:`pathfuse.planners.drive`).
+    :meth:`command` reads it through :attr:`acts_unicycle`."""
 
     def __init__(self, problem: Problem, params: Any, plan: Any = None, *,
                  dt: float | None = None, max_speed: float | None = None) -> None:
@@ -141,6 +142,14 @@ class Controller:
         #: by the emergency stop, found no clear command for, or evaded a disc with
         #: (indexed by :data:`pathfuse.shield.CODE_NAMES`).
         self.shield_counts = np.zeros(5, dtype=np.int64)
+        self._disc_speeds: dict[int, float] = {}
+
+    @property
+    def acts_unicycle(self) -> bool:
+        """Whether this controller's :meth:`act` answers ``(v, omega)`` on a diff-drive
+        robot (the class's :attr:`native_unicycle`; a controller that decides per robot,
+        as the path followers do, overrides this)."""
+        return self.native_unicycle
 
     @property
     def global_path(self) -> np.ndarray | None:
@@ -176,7 +185,7 @@ class Controller:
         rb = self.problem.robot
         if rb is None:
             return a
-        if rb.is_diff_drive and not self.native_unicycle:
+        if rb.is_diff_drive and not self.acts_unicycle:
             from pathfuse.planners.drive import to_unicycle
 
             a = to_unicycle(self.problem, rb, float(self.dt),  # type: ignore[arg-type]
@@ -198,9 +207,10 @@ class Controller:
         clear = float(pb.robot_radius_m) + MARGIN_FRAC * res
         sens = obs.obstacles
         if len(sens):
-            dp, dv, dr = _plain(sens.positions), _plain(sens.velocities), _plain(sens.radii)
+            dp, dr = _plain(sens.positions), _plain(sens.radii)
+            dv = self._disc_speed_bounds(sens)
         else:
-            dp, dv, dr = _NO_DISCS
+            dp, dv, dr = _NO_DISCS[0], _NO_DISCS[2], _NO_DISCS[2]
         cmd = obs.command
         dt = float(self.dt)  # type: ignore[arg-type]
         if rb.is_diff_drive:
@@ -218,6 +228,19 @@ class Controller:
                 rb.max_accel_mps2, clear, float(pb.robot_radius_m), dp, dv, dr, 0.0)
         self.shield_counts[code] += 1
         return np.array([u, w])
+
+    def _disc_speed_bounds(self, sens: Any) -> np.ndarray:
+        """The fastest speed observed so far of each sensed disc (by id): the shield's bound
+        on how fast it can come."""
+        seen = self._disc_speeds
+        ids = np.asarray(sens.ids)
+        speed = np.hypot(sens.velocities[:, 0], sens.velocities[:, 1])
+        out = np.empty(speed.shape[0])
+        for j in range(speed.shape[0]):
+            k = int(ids[j])
+            out[j] = max(float(speed[j]), seen.get(k, 0.0))
+            seen[k] = out[j]
+        return out
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:

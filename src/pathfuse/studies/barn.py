@@ -463,7 +463,14 @@ def trajectory_with_yaw(times: np.ndarray, positions: np.ndarray,
 def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: float,
                    robot_radius_m: float, optimal_time_s: float,
                    trajectory: bool = True) -> dict[str, Any]:
-    """One episode as the challenge reports it, from its stored run."""
+    """One episode as the challenge reports it, from its stored run.
+
+    Besides the challenge's fields: ``collision_at_fault`` (on a collision, whether the
+    robot moved into it; None otherwise; see :class:`pathfuse.world.Episode`) and the
+    safety shield's counts ``shield_asked`` ... ``shield_evade`` (None for a row stored
+    before they existed)."""
+    from pathfuse.world.episode import stored_at_fault, stored_shield_counts
+
     m = json.loads(row.get("metrics") or "{}")
     blob = row.get("path")
     pos = np.frombuffer(blob, dtype="<f8").reshape(-1, 2) if blob else \
@@ -492,6 +499,8 @@ def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: f
         "min_static_clearance_m": m.get("min_static_clearance_m"),
         "ticks": int(pos.shape[0] - 1),
         "message": row.get("message") or "",
+        "collision_at_fault": stored_at_fault(m, status),
+        **stored_shield_counts(m),
     }
     if trajectory:
         hblob = row.get("headings")

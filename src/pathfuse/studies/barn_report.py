@@ -3,8 +3,15 @@
 :func:`summary_rows` gives, per planner, the episodes, the success, collision
 and timeout counts and rates with 95 % Wilson intervals, the mean metric over
 every episode (failures count 0) with a 95 % Student-t interval, and the mean
-time over the successful episodes with its interval.  :func:`markdown_report`
-lays them out with the challenge's published DWA baseline as a reference line:
+time over the successful episodes with its interval.  Beside them: the
+collisions split into the robot's fault (it was moving, or hit the static map)
+and hits while it stood still (:func:`fault_stats`; on BARN's static worlds
+every collision is the robot's), the 5th and 50th percentiles of the minimum
+static clearance over the successful episodes (:func:`percentile_stats`), and
+how often the safety shield replaced a command (:func:`shield_stats`).  Rows
+stored before these values existed summarise too: their cells read n/a.
+:func:`markdown_report` lays them out with the challenge's published DWA
+baseline as a reference line:
 that baseline was measured in Gazebo with a real navigation stack (laser
 scans, costmaps, physics), so it is a landmark, not a like-for-like comparison.
 
@@ -26,12 +33,81 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from pathfuse.stats import markdown_table, mean_ci, wilson_ci, write_csv
 
 __all__ = ["summary_rows", "markdown_report", "text_table", "write_barn_outputs",
-           "OUTCOMES"]
+           "OUTCOMES", "PERCENTILES", "fault_stats", "percentile_stats", "shield_stats",
+           "fault_cell", "percentile_cell", "shield_cell"]
 
 OUTCOMES = ("success", "collision", "timeout")
+PERCENTILES = (5, 50)
+"""The percentiles of the minimum clearances reported (over successful episodes)."""
+
+
+def fault_stats(flags: Sequence[bool | None], n: int) -> dict[str, Any]:
+    """The collisions of ``n`` episodes split by fault (``flags``: each collision's
+    ``collision_at_fault``): ``collision_at_fault`` and ``collision_standing`` with
+    their rates over the ``n`` episodes and 95 % Wilson intervals, and
+    ``collision_fault_unknown`` (collisions stored without the value).  With any
+    unknown the split is unknown: counts None, rates NaN.
+
+    >>> r = fault_stats([True, True, False], 10)
+    >>> r["collision_at_fault"], r["collision_standing"], r["collision_standing_rate"]
+    (2, 1, 0.1)
+    >>> fault_stats([True, None], 4)["collision_at_fault"] is None
+    True
+    """
+    unknown = sum(f is None for f in flags)
+    out: dict[str, Any] = {}
+    for key, want in (("collision_at_fault", True), ("collision_standing", False)):
+        if unknown:
+            out.update({key: None, f"{key}_rate": math.nan, f"{key}_ci_low": math.nan,
+                        f"{key}_ci_high": math.nan})
+            continue
+        k = sum(f is want for f in flags)
+        p, lo, hi = wilson_ci(k, n)
+        out.update({key: k, f"{key}_rate": p, f"{key}_ci_low": lo, f"{key}_ci_high": hi})
+    out["collision_fault_unknown"] = unknown
+    return out
+
+
+def percentile_stats(values: Sequence[float | None], prefix: str,
+                     unit: str = "_m") -> dict[str, Any]:
+    """``prefix_n`` (the finite values) and ``prefix_p5{unit}``, ``prefix_p50{unit}``
+    (:data:`PERCENTILES`; numpy's linear interpolation between order statistics; NaN
+    without a finite value).
+
+    >>> percentile_stats([0.0, None, 1.0, math.inf], "gap")
+    {'gap_n': 2, 'gap_p5_m': 0.05, 'gap_p50_m': 0.5}
+    """
+    v = [float(x) for x in values if x is not None and math.isfinite(float(x))]
+    out: dict[str, Any] = {f"{prefix}_n": len(v)}
+    for q in PERCENTILES:
+        out[f"{prefix}_p{q}{unit}"] = float(np.percentile(v, q)) if v else math.nan
+    return out
+
+
+def shield_stats(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The safety shield's counts summed over ``records`` (``shield_<name>``, None when
+    no record has them), ``shield_commands`` (their total) and ``shield_replaced_rate``
+    (the share of commands it did not pass as asked; NaN without counts).
+
+    >>> shield_stats([{"shield_asked": 3, "shield_nearest": 1}])["shield_replaced_rate"]
+    0.25
+    """
+    from pathfuse.shield import CODE_NAMES
+
+    keys = [f"shield_{c}" for c in CODE_NAMES]
+    have = [r for r in records if any(r.get(k) is not None for k in keys)]
+    out: dict[str, Any] = {k: (sum(int(r.get(k) or 0) for r in have) if have else None)
+                           for k in keys}
+    total = sum(out[k] or 0 for k in keys)
+    out["shield_commands"] = total if have else None
+    replaced = total - (out["shield_asked"] or 0)
+    out["shield_replaced_rate"] = replaced / total if total else math.nan
+    return out
 
 
 def summary_rows(records: Sequence[Mapping[str, Any]],
@@ -60,6 +136,11 @@ def summary_rows(records: Sequence[Mapping[str, Any]],
             if r["status"] == "timeout" and s and s != "TIMEOUT":
                 detail[s] = detail.get(s, 0) + 1
         row["timeout_detail"] = ", ".join(f"{k} {v}" for k, v in sorted(detail.items()))
+        row.update(fault_stats([r.get("collision_at_fault") for r in recs
+                                if r["status"] == "collision"], n))
+        row.update(percentile_stats([r.get("min_static_clearance_m") for r in recs
+                                     if r["status"] == "success"], "min_static_clearance"))
+        row.update(shield_stats(recs))
         rows.append(row)
     return rows
 
@@ -83,22 +164,46 @@ def _mean(r: Mapping[str, Any], key: str, unit: str = "", fmt: str = "{:.4f}") -
     return f"{fmt.format(m)} [{fmt.format(lo)}, {fmt.format(hi)}]"
 
 
+def fault_cell(r: Mapping[str, Any]) -> str:
+    """``"at fault / standing"`` counts of a summary row, n/a when unknown."""
+    a, b = r.get("collision_at_fault"), r.get("collision_standing")
+    return "n/a" if a is None or b is None else f"{a} / {b}"
+
+
+def percentile_cell(r: Mapping[str, Any], prefix: str, unit: str = "_m",
+                    fmt: str = "{:.3g}") -> str:
+    """``"p5 / p50"`` of a summary row (3 significant digits: a clearance of a few
+    micrometres stays visible), n/a without values."""
+    vals = [r.get(f"{prefix}_p{q}{unit}") for q in PERCENTILES]
+    if any(v is None or not math.isfinite(v) for v in vals):
+        return "n/a"
+    return " / ".join(fmt.format(v) for v in vals)
+
+
+def shield_cell(r: Mapping[str, Any]) -> str:
+    """The share of commands the shield replaced, n/a without counts."""
+    p = r.get("shield_replaced_rate")
+    return "n/a" if p is None or not math.isfinite(p) else f"{100 * p:.1f}%"
+
+
 def _table(rows: Sequence[Mapping[str, Any]], baseline: Mapping[str, Any] | None
            ) -> list[list[str]]:
-    head = ["planner", "success [95% CI]", "collision", "timeout", "mean metric [95% CI]",
-            "mean time (s), successes [95% CI]"]
+    head = ["planner", "success [95% CI]", "collision", "robot at fault / hit standing",
+            "timeout", "mean metric [95% CI]", "mean time (s), successes [95% CI]",
+            "min static clearance (m), successes: p5 / p50", "shield: commands replaced"]
     table = [head]
     for r in rows:
         to = _rate(r, "timeout")
         if r.get("timeout_detail"):
             to += f" (of which {r['timeout_detail']})"
-        table.append([r["planner"], _rate(r, "success"), _rate(r, "collision"), to,
-                      _mean(r, "metric"), _mean(r, "time", "_s", "{:.2f}")])
+        table.append([r["planner"], _rate(r, "success"), _rate(r, "collision"),
+                      fault_cell(r), to, _mean(r, "metric"), _mean(r, "time", "_s", "{:.2f}"),
+                      percentile_cell(r, "min_static_clearance"), shield_cell(r)])
     if baseline:
         table.append([f"*{baseline['planner']}*", f"*{100 * baseline['success']:.1f}%*",
-                      f"*{100 * baseline['collision']:.1f}%*",
+                      f"*{100 * baseline['collision']:.1f}%*", "n/a",
                       f"*{100 * baseline['timeout']:.1f}%*", f"*{baseline['metric']:.4f}*",
-                      f"*{baseline['time_s']:.2f}*"])
+                      f"*{baseline['time_s']:.2f}*", "n/a", "n/a"])
     return table
 
 
@@ -131,7 +236,16 @@ def markdown_report(run: Any, rows: Sequence[Mapping[str, Any]] | None = None) -
         "optimal_time), at most 0.5) averaged over every episode, failures counting 0; the "
         "mean time is over the successful episodes only.  A timeout is every episode that "
         "neither reached the goal nor collided: the planner's own give-ups (no path, "
-        "stalled) are listed beside it.\n\n"
+        "stalled) are listed beside it.  A collision is the robot's fault when it was "
+        "moving during the colliding tick (any collision with the static map is); \"hit "
+        "standing\" counts moving discs that walked into it standing still (BARN's worlds "
+        "have none, so every collision here is the robot's).  The minimum static "
+        "clearance is each successful episode's least gap between the robot disc and the "
+        "map (exact over every tick, capped at 2 m), given as its 5th and 50th "
+        "percentiles over those episodes; \"shield: commands replaced\" is the share of "
+        "commands the safety shield did not pass as asked (a nearby safe command, the "
+        "emergency stop, or a disc evasion).  n/a: no such episode, or episodes stored "
+        "before the value existed.\n\n"
         f"*{DWA_BASELINE['planner']}*: {DWA_BASELINE['note']}.  pathfuse simulates a disc "
         "robot with exact continuous collision checks against the occupied cells, perfect "
         "localisation and the map known in advance, so its rates are not those a Gazebo "

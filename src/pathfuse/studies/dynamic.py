@@ -14,9 +14,12 @@ per-episode CSV, whatever its status.
 
 :func:`summary_rows` reduces them per (``K``, planner): the counts of each
 status (they add up to the number of episodes), the success / collision /
-timeout / local-minimum / no-path rates with 95 % Wilson intervals, and path
+timeout / local-minimum / no-path rates with 95 % Wilson intervals, the
+collisions split into the robot's fault and hits while it stood still, path
 length and time to goal over the successful episodes (mean with a 95 %
-interval: Student-t for the length, seeded bootstrap for the time; median).
+interval: Student-t for the length, seeded bootstrap for the time; median),
+the 5th and 50th percentiles of the minimum static clearance and disc gap
+over the successful episodes, and the share of commands the shield replaced.
 :func:`write_dynamic_outputs` writes them as
 Markdown and CSV with a plot of the success rate against ``K``.
 
@@ -45,6 +48,14 @@ import numpy as np
 from pathfuse.bench.summary import group_stats, value_stats
 from pathfuse.result import ConfigError
 from pathfuse.stats import markdown_table, write_csv
+from pathfuse.studies.barn_report import (
+    fault_cell,
+    fault_stats,
+    percentile_cell,
+    percentile_stats,
+    shield_cell,
+    shield_stats,
+)
 from pathfuse.validate import short as _shown
 
 __all__ = [
@@ -249,7 +260,10 @@ def dynamic_experiment(config: DynamicConfig | None = None,
 
 
 def _record(moving: int, index: int, row: dict[str, Any]) -> dict[str, Any]:
-    """One episode's record, from its stored run."""
+    """One episode's record, from its stored run (``collision_at_fault`` and the shield
+    counts are None where the row predates them)."""
+    from pathfuse.world.episode import stored_at_fault, stored_shield_counts
+
     m = json.loads(row["metrics"] or "{}")
     t = json.loads(row["timing"] or "{}")
 
@@ -279,6 +293,8 @@ def _record(moving: int, index: int, row: dict[str, Any]) -> dict[str, Any]:
         "setup_time_s": float(t.get("setup_time_s", 0.0)),
         "wall_s": float(row["wall_time"] or 0.0),
         "message": row["message"] or "",
+        "collision_at_fault": stored_at_fault(m, row["status_name"]),
+        **stored_shield_counts(m),
     }
 
 
@@ -338,7 +354,9 @@ def run_dynamic(
 def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
     """One row per (moving, planner): status counts and rates with 95 % Wilson intervals,
     path length and time to goal over the successful episodes (mean, 95 % CI, median),
-    and the mean planning time per tick (:func:`~pathfuse.bench.summary.group_stats`)."""
+    and the mean planning time per tick (:func:`~pathfuse.bench.summary.group_stats`);
+    then the collisions by fault, the clearance percentiles over the successful episodes
+    and the shield's counts (:mod:`pathfuse.studies.barn_report`'s helpers)."""
     rows = []
     for k in run.config.moving:
         for name in run.config.planners:
@@ -361,6 +379,11 @@ def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
                 row.update(v)
             row["mean_plan_time_us"] = 1e6 * float(np.mean([r["mean_plan_time_s"]
                                                            for r in recs])) if recs else math.nan
+            row.update(fault_stats([r.get("collision_at_fault") for r in recs
+                                    if r["status"] == "COLLISION"], len(recs)))
+            for col in ("min_static_clearance", "min_obstacle_distance"):
+                row.update(percentile_stats([r.get(f"{col}_m") for r in ok], col))
+            row.update(shield_stats(recs))
             rows.append(row)
     return rows
 
@@ -453,7 +476,9 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
     lo, hi = cfg.speed_range
     head = ["discs", "planner", "success [95% CI]", "collision", "timeout", "local min",
             "no path", "path length (m) mean [95% CI]", "median", "time to goal (s) mean "
-            "[95% CI]", "median", "plan time/tick (µs)"]
+            "[95% CI]", "median", "plan time/tick (µs)", "collisions: robot at fault / "
+            "hit standing", "min static clearance (m) p5 / p50", "min disc gap (m) p5 / p50",
+            "shield: commands replaced"]
     table = [head]
     for r in rows:
         table.append([
@@ -463,7 +488,11 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
             _stat_cell(r, "path_length", "m"), _median_cell(r, "path_length", "m"),
             _stat_cell(r, "time_to_goal", "s"), _median_cell(r, "time_to_goal", "s"),
             "n/a" if not np.isfinite(r["mean_plan_time_us"]) else f"{r['mean_plan_time_us']:.0f}",
+            fault_cell(r), percentile_cell(r, "min_static_clearance"),
+            percentile_cell(r, "min_obstacle_distance"), shield_cell(r),
         ])
+    fault = success_pivot(rows, "collision_at_fault") \
+        if all(r["collision_at_fault"] is not None for r in rows) else None
     params = "; ".join(f"{n}: {dict(p)}" for n, p in cfg.params.items() if p) or "defaults"
     return (
         "# Dynamic benchmark: online planners among moving obstacles\n\n"
@@ -481,6 +510,12 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
         f"{markdown_table(success_pivot(rows))}\n\n"
         "## Collision rate [95% Wilson CI]\n\n"
         f"{markdown_table(success_pivot(rows, 'collision'))}\n\n"
+        + ("" if fault is None else
+           "## Collisions that were the robot's fault [95% Wilson CI]\n\n"
+           "The robot was moving during the colliding tick (or hit the static map); the "
+           "rest of the collisions are discs walking into it standing still, which the "
+           "safety shield's passive safety allows.\n\n"
+           f"{markdown_table(fault)}\n\n") +
         f"{_paired_md(run)}"
         "## All outcomes\n\n"
         f"{markdown_table(table)}\n\n"
@@ -490,7 +525,12 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
         "of the mean: Student-t for the length, a percentile bootstrap (2000 resamples, seed "
         "0) for the time to goal, which stays within the range of the data.  "
         "Plan time is the wall-clock time of the planner's per-tick "
-        "decision, averaged over ticks and then over episodes.\n"
+        "decision, averaged over ticks and then over episodes.  The minimum static "
+        "clearance and disc gap are each successful episode's least gap between the robot "
+        "disc and the map, and the moving discs (exact over every tick), as 5th and 50th "
+        "percentiles over those episodes.  \"Shield: commands replaced\" is the share of "
+        "commands the safety shield did not pass as asked.  n/a: no such episode (no disc "
+        "for the gap), or episodes stored before the value existed.\n"
     )
 
 

@@ -31,6 +31,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -47,7 +48,7 @@ from pathfuse.world.robot import RobotSpec, parse_robot
 from pathfuse.world.scenario import Scenario, load_scenario, resolve_planner_choice
 from pathfuse.world.world import World
 
-__all__ = ["Episode", "simulate", "run_episode"]
+__all__ = ["Episode", "simulate", "run_episode", "stored_at_fault", "stored_shield_counts"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,6 +113,19 @@ class Episode:
     commands : (T - 1, 2) float array
         The action applied at each tick: ``(vx, vy)`` for a holonomic robot,
         ``(v, omega)`` for a diff-drive one (after clipping).
+    collision_at_fault : bool or None
+        On a collision, whether it was the robot's fault: ``True`` when the
+        robot was moving during the colliding tick (a non-zero linear speed or
+        holonomic velocity) or hit the static map, ``False`` when a moving disc
+        walked into the robot standing still (which the safety shield's
+        *passive* safety allows).  ``None`` without a collision.
+    shield_counts : dict of str to int
+        How often the safety shield (:mod:`pathfuse.shield`) passed the
+        controller's command (``asked``), replaced it by a nearby safe one
+        (``nearest``), by the emergency stop (``emergency``), found no clear
+        command (``unsafe``) or evaded a predicted disc contact (``evade``);
+        keys :data:`pathfuse.shield.CODE_NAMES`.  Empty when the controller
+        has no shield counts.
     """
 
     status: Status
@@ -139,6 +153,8 @@ class Episode:
     seed: int | None = None
     headings: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
     commands: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
+    collision_at_fault: bool | None = None
+    shield_counts: dict[str, int] = field(default_factory=dict)
 
     @property
     def reached(self) -> bool:
@@ -180,6 +196,8 @@ class Episode:
             "status": self.status.name,
             "message": self.message,
             "collision_with": self.collision_with,
+            "collision_at_fault": self.collision_at_fault,
+            "shield_counts": dict(self.shield_counts),
             "path_length_m": float(self.path_length_m),
             "time_to_goal_s": fin(self.time_to_goal_s),
             "min_distance_m": fin(self.min_distance_m),
@@ -276,6 +294,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
     status = Status.TIMEOUT
     message = ""
     collision_with = None
+    at_fault: bool | None = None
     n = 1
     if ctrl.failure is not None:
         status, message = ctrl.failure
@@ -305,10 +324,13 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
                 else:
                     status = Status.COLLISION
                     collision_with = info["collision"]
+                    at_fault = info.get("at_fault")
                     what = "the static map" if collision_with == "static" \
                         else f"moving obstacle {collision_with}"
                     message = f"collided with {what} during tick {n - 2} -> {n - 1} " \
                               f"(t = {obs.time:.2f} s)"
+                    if at_fault is False:
+                        message += ": it hit the robot standing still"
                 break
             if truncated:
                 message = f"time limit {sc.time_limit:g} s reached"
@@ -350,7 +372,60 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
         seed=world.seed,
         headings=headings[:n].copy(),
         commands=commands[:t].copy(),
+        collision_at_fault=at_fault,
+        shield_counts=_shield_counts(ctrl),
     )
+
+
+def _shield_counts(ctrl: Any) -> dict[str, int]:
+    """The controller's shield counts by :data:`pathfuse.shield.CODE_NAMES` (empty
+    without them)."""
+    from pathfuse.shield import CODE_NAMES
+
+    counts = getattr(ctrl, "shield_counts", None)
+    if counts is None:
+        return {}
+    vals = np.asarray(counts).reshape(-1)
+    return {name: int(vals[i]) if i < vals.shape[0] else 0
+            for i, name in enumerate(CODE_NAMES)}
+
+
+def stored_at_fault(metrics: Mapping[str, Any], status: str) -> bool | None:
+    """``collision_at_fault`` of a stored episode, from the ``metrics`` JSON of its row.
+
+    None unless the episode ended in a collision.  A row written before the value
+    existed has none: a collision with the static map is then still the robot's
+    (always, by definition), one with a disc is unknown (None).
+
+    >>> stored_at_fault({"collision_with": 2}, "COLLISION") is None
+    True
+    >>> stored_at_fault({"collision_with": "static"}, "COLLISION")
+    True
+    >>> stored_at_fault({"collision_with": 2, "collision_at_fault": False}, "COLLISION")
+    False
+    """
+    if str(status).upper() != "COLLISION":
+        return None
+    v = metrics.get("collision_at_fault")
+    if v is not None:
+        return bool(v)
+    return True if metrics.get("collision_with") == "static" else None
+
+
+def stored_shield_counts(metrics: Mapping[str, Any]) -> dict[str, int | None]:
+    """``shield_<name>`` -> count (:data:`pathfuse.shield.CODE_NAMES`) of a stored
+    episode's ``metrics``; None for each where the row has none (older rows).
+
+    >>> stored_shield_counts({"shield_asked": 7})["shield_asked"]
+    7
+    """
+    from pathfuse.shield import CODE_NAMES
+
+    out: dict[str, int | None] = {}
+    for name in CODE_NAMES:
+        v = metrics.get(f"shield_{name}")
+        out[f"shield_{name}"] = None if v is None else int(v)
+    return out
 
 
 def _robot_spec(robot: Any) -> RobotSpec:

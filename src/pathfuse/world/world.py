@@ -42,6 +42,16 @@ Collisions (checked over the whole tick, not at its end points)
   (:func:`~pathfuse.world.geometry.disc_sweep_gaps`); along an arc,
   :func:`~pathfuse.sweep.arc_disc_gaps`.
 
+Who is at fault (``info["at_fault"]``)
+--------------------------------------
+On a collision, ``True`` when the robot was moving during the colliding tick
+(the applied command's linear speed, or the holonomic velocity, is non-zero)
+and ``False`` when a moving disc walked into a robot standing still (a
+diff-drive robot turning on the spot counts as standing: its disc footprint
+does not move).  A static collision is always the robot's fault.  ``None``
+without a collision.  The safety shield (:mod:`pathfuse.shield`) guarantees
+only *passive* safety, so the benchmarks count the two kinds apart.
+
 ``terminated`` is ``True`` on a collision or when the robot's centre passes
 within ``goal_tolerance`` of the goal during the tick (a collision in the
 same tick wins: the conservative reading); ``truncated`` is ``True`` when the
@@ -310,7 +320,10 @@ class World:
             ``event`` ("reached", "collision" or None), ``collision``
             ("static", the index of the disc hit, or None), ``static_gap``
             and ``obstacle_gap`` (least clearance over the tick, metres;
-            ``inf`` without discs), ``clipped`` (speed limited).
+            ``inf`` without discs), ``clipped`` (speed limited), ``at_fault``
+            (on a collision: ``True`` when the robot moved during the tick or hit
+            the static map, ``False`` when a disc hit it standing still; ``None``
+            without a collision; see the module docstring).
         """
         if self._done:
             raise PathfuseError("the episode is over; call reset() to start another")
@@ -349,10 +362,12 @@ class World:
                 hit_disc = j
         event = None
         collision: Any = None
+        at_fault: bool | None = None
         if static_gap < 0.0:
-            event, collision = "collision", "static"
+            event, collision, at_fault = "collision", "static", True
         elif hit_disc >= 0:
             event, collision = "collision", hit_disc
+            at_fault = self._moving(cmd)
         elif self._passes_goal(p0, p1, th0, cmd, arc):
             event = "reached"
         self.position = p1
@@ -364,8 +379,15 @@ class World:
         truncated = (not terminated) and self._tick >= self.n_steps
         self._done = terminated or truncated
         info = {"event": event, "collision": collision, "static_gap": static_gap,
-                "obstacle_gap": obstacle_gap, "clipped": clipped}
+                "obstacle_gap": obstacle_gap, "clipped": clipped, "at_fault": at_fault}
         return self.observe(), terminated, truncated, info
+
+    def _moving(self, cmd: np.ndarray) -> bool:
+        """Whether the applied command moves the robot's disc: a non-zero linear speed
+        (diff-drive; turning on the spot leaves the disc where it is) or velocity."""
+        if self.diff_drive:
+            return bool(cmd[0] != 0.0)
+        return bool(cmd[0] != 0.0 or cmd[1] != 0.0)
 
     def _passes_goal(self, p0: np.ndarray, p1: np.ndarray, th0: float, cmd: np.ndarray,
                      arc: bool) -> bool:

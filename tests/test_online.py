@@ -38,7 +38,7 @@ from pathfuse.world import (
 )
 from pathfuse.world.generate import generate_scenarios
 
-PLANNERS = ["fusion", "apf", "astar", "astar-replan", "ref6", "ref7", "dwa"]
+PLANNERS = ["fusion", "apf", "astar", "astar-replan", "ref6", "ref7", "dwa", "mppi"]
 HALL = ["." * 15] * 5
 
 
@@ -192,11 +192,17 @@ def test_head_on_astar_collides_and_fusion_passes():
 
 def test_head_on_pure_radial_repulsion_cannot_pass():
     # without the tangential part and the dodge (the paper's eq. 6 alone) the robot can
-    # only back off, pushed by the disc until it is pinned against the wall behind it
-    ep = simulate(head_on(), planner={"name": "fusion",
-                                      "params": {"swerve": 0.0, "dodge": False}})
+    # only back off, pushed by the disc until it is pinned against the wall behind it (the
+    # controller alone: the safety shield, which would move it aside at the last moment, off)
+    doc = head_on(robot={"radius": 0.2, "max_speed": 1.0, "sensing_radius": 3.0,
+                         "shield": False})
+    ep = simulate(doc, planner={"name": "fusion", "params": {"swerve": 0.0, "dodge": False}})
     assert ep.status is Status.COLLISION
     assert np.abs(ep.positions[:, 1] - 2.5).max() < 1e-9
+    # with the shield the robot is standing when the disc reaches it: not its fault
+    ep = simulate(head_on(), planner={"name": "fusion",
+                                      "params": {"swerve": 0.0, "dodge": False}})
+    assert ep.status is Status.COLLISION and ep.collision_at_fault is False
 
 
 @pytest.mark.parametrize("planner", ["astar-replan", "apf", "ref6", "ref7"])
@@ -333,7 +339,11 @@ def test_fusion_escapes_the_u_trap_whichever_way_it_faces(turn):
 # ----------------------------------------------------------------------------- astar-replan
 def test_astar_replan_replans_at_its_rate_and_goes_around_a_standing_disc():
     doc = head_on(obstacles=[{"position": [7.5, 2.5], "velocity": [0, 0], "radius": 0.6}])
-    assert simulate(doc, planner="astar").status is Status.COLLISION
+    # the blind follower walks into the standing disc unless the shield steers it round
+    blind = dict(doc, robot={**doc["robot"], "shield": False})
+    assert simulate(blind, planner="astar").status is Status.COLLISION
+    ep = simulate(doc, planner="astar")
+    assert ep.status is Status.SUCCESS and ep.shield_counts["nearest"] > 0
     params = ReplanParams(replan_period_s=0.5)
     ep = run_episode(load_scenario(doc), "astar-replan", params)
     assert ep.status is Status.SUCCESS

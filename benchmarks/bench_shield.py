@@ -36,7 +36,7 @@ import numpy as np
 
 from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.drive import admissible
-from pathfuse.shield import shield_unicycle, warmup_shield
+from pathfuse.shield import CODE_NAMES, shield_unicycle, warmup_shield
 from pathfuse.studies.barn import BarnConfig, _scenario, find_worlds, jackal_robot
 from pathfuse.world import load_scenario, simulate
 
@@ -112,8 +112,8 @@ def main() -> None:
         x = np.asarray(vals) * 1e6
         print(f"{name:24s} {np.median(x):10.1f} {np.percentile(x, 95):9.1f} {x.max():9.1f} "
               f"{np.median(x) / (ref * 1e6):18.1f}")
-    names = ("asked", "nearest", "emergency", "unsafe", "evade")
-    print("adversarial commands: " + ", ".join(f"{n} {c}" for n, c in zip(names, codes)))
+    print("adversarial commands: " + ", ".join(f"{n} {codes[i]}"
+                                               for i, n in enumerate(CODE_NAMES)))
 
 
 if __name__ == "__main__":

@@ -76,6 +76,7 @@ from pathfuse.field.kernels import (
     N_S,
     S_BACKOFF,
     S_ESCAPES,
+    S_K,
     S_REF,
     fusion_loop,
     pack_fusion,
@@ -83,7 +84,7 @@ from pathfuse.field.kernels import (
 from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
 from pathfuse.grid import GridMap
-from pathfuse.planners.base import FieldController
+from pathfuse.planners.base import _NO_DISCS, FieldController, _plain
 from pathfuse.planners.params import DiscParams, FieldParams, GlobalAStarParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -119,6 +120,11 @@ class FusionParams(GlobalAStarParams, DiscParams, FieldParams):
                                     "the paper as printed)")
     escape_points: int = param(3, ge=1, help="A* points to follow in an escape before "
                                              "Algorithm 2 resumes")
+    velocity_space: bool = param(True, help="diff-drive robot online: choose (v, omega) from "
+                                            "the dynamic window by agreement with Algorithm "
+                                            "2's move, clearance and the predicted discs "
+                                            "(ours); false: the shared conversion of "
+                                            "planners/drive.py")
 
 
 class FusionController(FieldController):
@@ -149,6 +155,46 @@ class FusionController(FieldController):
             problem.clearance_m, p.static_repulsion == "boundary", p.boundary_offset_m)
         self.state = np.zeros(N_S, dtype=np.int64)
         self.kbuf = np.zeros(self.buf.shape[0], dtype=np.int64)
+        rb = problem.robot
+        self._window: Any = None
+        if self.online and rb is not None and rb.is_diff_drive and p.velocity_space:
+            from pathfuse.planners.fusion_window import ForceWindow
+
+            self._window = ForceWindow(problem, float(self.dt))  # type: ignore[arg-type]
+
+    def command(self, obs: Any) -> np.ndarray:
+        """On a diff-drive robot with ``velocity_space`` (ours): Algorithm 2's move for this
+        tick scored in velocity space (:mod:`pathfuse.planners.fusion_window`), then the
+        shield; otherwise as every controller (:meth:`Controller.command`)."""
+        if self._window is None:
+            return super().command(obs)
+        self.act(obs)
+        a = self._window.choose(obs, self._streamline(obs), self.pts, self.cum,
+                                int(self.state[S_K]))
+        if not self.problem.robot.shield:  # type: ignore[union-attr]
+            return a
+        return self._shielded(obs, a)
+
+    def _streamline(self, obs: Any) -> np.ndarray:
+        """The robot's position and Algorithm 2's next moves from its present state (the
+        move just made and up to the window's horizon of further ones, among the sensed
+        discs as they are now), without committing them: the fusion's local path."""
+        n0 = self.n
+        here = np.array([[float(obs.position[0]), float(obs.position[1])]])
+        if n0 < 2 or self._window is None:
+            return here
+        keep = (self.buf, self.kbuf, self.state.copy(), self.buf[:n0].copy(),
+                self.kbuf[:n0].copy())
+        sens = obs.obstacles
+        discs = (_plain(sens.positions), _plain(sens.velocities), _plain(sens.radii)) \
+            if len(sens) else _NO_DISCS
+        self._call(self._window.steps, *discs)
+        line = np.concatenate([here, self.buf[n0 - 1:self.n]])
+        self.buf, self.kbuf, self.state = keep[0], keep[1], keep[2]
+        self.buf[:n0] = keep[3]
+        self.kbuf[:n0] = keep[4]
+        self.n = n0
+        return line
 
     def _call(self, max_steps: int, dpos: np.ndarray, dvel: np.ndarray,
               drad: np.ndarray) -> tuple[int, int]:
@@ -176,12 +222,17 @@ class FusionController(FieldController):
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:
-        return (fusion_loop,)
+        from pathfuse.planners.dwa_kernel import dwa_choose
+
+        return (fusion_loop, dwa_choose)
 
     @classmethod
     def warmup(cls) -> None:
         if _WARM[0]:
             return
+        from pathfuse.planners.dwa import DWAController
+
+        DWAController.warmup()  # the velocity-space fusion scores with dwa's window
         g = GridMap.from_rows(["....", ".#..", "...."])
         path = [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
         follow_path(g, (0.5, 0.5), (3.5, 2.5), path)

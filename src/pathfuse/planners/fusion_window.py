@@ -1,0 +1,209 @@
+"""The fusion in velocity space, for a diff-drive robot (ours).
+
+The paper's Algorithm 2 decides a *move*: the resultant of the goal's and the
+A* points' attraction (within ``r1``) and the obstacles' repulsion (within
+``r2``), one safe step along it, with our escape from local minima.  A
+holonomic robot takes that move as its velocity (the paper's model, and
+pathfuse's Tables I/II).  A diff-drive robot cannot: it must turn and brake,
+and following the move's direction tick by tick made it swing and graze
+(the README's BARN and dynamic studies before this module).
+
+:class:`ForceWindow` keeps Algorithm 2 as the judge of *where* to go and lets
+the dynamic window decide *how*.  Each tick:
+
+1. Algorithm 2 makes its move (:meth:`FieldController.act
+   <pathfuse.planners.base.FieldController.act>`: the force of eqs. 3-6 with
+   the A* points within ``r1``, the safe step, the escape, the sensed discs'
+   repulsion) and looks ahead ``horizon`` (2.5 s) of further moves without
+   committing them: the field's streamline from the robot, the fusion's
+   *local path*;
+2. the reachable ``(v, omega)`` window is sampled and rolled out as ``dwa``
+   does (:func:`pathfuse.planners.dwa_kernel.dwa_choose`, ``dwa``'s default
+   critics), scored against that local path: distance from it and progress
+   along it (agreement with the field), heading, speed, static clearance
+   (``exp(-gap / 0.1 m)`` within 0.5 m) and the sensed discs predicted at
+   constant velocity;
+3. the best command goes through the safety shield (:mod:`pathfuse.shield`).
+
+Where the local path's bearing is more than 60 degrees off the heading, or
+the window's best is to stand and turn, the robot turns on the spot towards
+it at the rate from which the turn can stop there (rotate to heading, as
+Regulated Pure Pursuit does: the window's 2.5 s constant-``omega`` rollouts
+wrap around and would spin past it).  When Algorithm 2 goes nowhere (its
+local path ends within a quarter of its nominal length of the robot) the
+A* path from the robot's progress takes its place.
+
+Recovery (ours): when the robot has moved less than 0.3 m in 3 s, A* is
+planned again from where it stands and followed for 4 s, then Algorithm 2
+resumes (the escape of Algorithm 2 backs out along the walked trail, which a
+robot that cannot follow the field's every turn does not have).
+
+``fusion.velocity_space: false`` turns all this off: the move is then
+converted by :func:`pathfuse.planners.drive.unicycle_command`, as before.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from pathfuse.field.pathing import polyline_cumlen
+from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.planners.dwa_kernel import dwa_choose, dwa_progress, pack_dwa
+
+__all__ = ["ForceWindow"]
+
+_NO_DISCS = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0))
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+class ForceWindow:
+    """The dynamic window scored against Algorithm 2's move (see the module docstring).
+
+    Parameters
+    ----------
+    problem : Problem
+        With a diff-drive :class:`~pathfuse.robot.RobotModel`.
+    dt : float
+        The tick (s).
+    """
+
+    def __init__(self, problem: Any, dt: float) -> None:
+        from pathfuse.planners.dwa import DWAParams
+
+        rb = problem.robot
+        p = DWAParams()
+        g = problem.grid
+        self.problem = problem
+        self.horizon_s = float(p.horizon_s)
+        self.vmax = float(rb.max_speed_mps)
+        ox, oy = g.origin
+        self.f = pack_dwa(
+            dt, rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2, rb.max_yaw_rate_radps,
+            rb.max_yaw_accel_radps2, problem.robot_radius_m,
+            problem.robot_radius_m + MARGIN_FRAC * g.resolution,
+            max(problem.clearance_m, rb.clearance_m), p.horizon_s, p.sim_step_s, p.v_samples,
+            p.w_samples, p.path_weight, p.goal_weight, p.heading_weight, p.speed_weight,
+            p.obstacle_weight, p.moving_weight, p.obstacle_range_m, p.lookahead_m,
+            p.inflation_decay_m, False, ox, oy, g.resolution)
+        self.steps = max(1, int(math.ceil(p.horizon_s / dt)))
+        """Algorithm 2's moves looked ahead each tick (the rollouts' horizon)."""
+        self.min_reach_m = 0.25 * self.steps * self.vmax * dt
+        """A local path whose end is closer than this to the robot (Algorithm 2 circling or
+        stalled in a local minimum) gives way to the A* path."""
+        self.on_line = 0
+        """Ticks scored against Algorithm 2's local path (the rest: against the A* path)."""
+        self.on_path = 0
+        self.look_m = float(p.lookahead_m)
+        self.rotate_rad = math.pi / 3.0
+        """Beyond this bearing of the local path (``look_m`` along it) the robot first turns
+        on the spot."""
+        self.rotations = 0
+        self.res = float(g.resolution)
+        self.stall_ticks = max(2, int(round(3.0 / dt)))
+        self.stall_m = 0.3
+        """Moving less than ``stall_m`` over ``stall_ticks`` ticks (3 s) starts a recovery."""
+        self.recover_ticks = max(1, int(round(4.0 / dt)))
+        self.recover_left = 0
+        self.recover_k = 0
+        self.recoveries = 0
+        self.rec_pts: np.ndarray | None = None
+        self.rec_cum = np.zeros(1)
+        self.trail = np.full((self.stall_ticks, 2), np.nan)
+        self.ticks = 0
+
+    def _replan(self, x: float, y: float) -> None:
+        from pathfuse.planners.global_astar import plan_global
+
+        pb = self.problem
+        gp = plan_global(pb.with_start((x, y)), "euclidean")
+        self.recoveries += 1
+        if not gp.success:
+            self.rec_pts = None
+            return
+        pts = np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2)
+        gx, gy = pb.goal
+        if pts[-1, 0] != gx or pts[-1, 1] != gy:
+            pts = np.concatenate([pts, [[gx, gy]]])
+        self.rec_pts = np.require(pts, np.float64, ("C", "W"))
+        self.rec_cum = polyline_cumlen(self.rec_pts)
+        self.recover_k = 0
+        self.recover_left = self.recover_ticks
+
+    def _stalled(self, x: float, y: float) -> bool:
+        i = self.ticks % self.stall_ticks
+        old = self.trail[i].copy()
+        self.trail[i] = (x, y)
+        self.ticks += 1
+        if self.recover_left > 0 or not np.isfinite(old[0]):
+            return False
+        if math.hypot(x - old[0], y - old[1]) >= self.stall_m:
+            return False
+        self.trail[:] = np.nan
+        return True
+
+    def choose(self, obs: Any, local: np.ndarray, pts: np.ndarray, cum: np.ndarray,
+               k: int) -> np.ndarray:
+        """``(v, omega)`` from the observation, Algorithm 2's local path ``local`` (the
+        robot's position, then the fusion's next moves) and, when that is empty (Algorithm 2
+        stands still), the A* path ``pts`` with its cumulative length ``cum`` from the
+        robot's progress index ``k``."""
+        x = float(obs.position[0])
+        y = float(obs.position[1])
+        sens = obs.obstacles
+        if len(sens):
+            dpos = np.require(sens.positions, np.float64, ("C", "W"))
+            dvel = np.require(sens.velocities, np.float64, ("C", "W"))
+            drad = np.require(sens.radii, np.float64, ("C", "W"))
+        else:
+            dpos, dvel, drad = _NO_DISCS
+        lc = polyline_cumlen(local)
+        net = math.hypot(float(local[-1, 0]) - x, float(local[-1, 1]) - y)
+        if self._stalled(x, y):
+            # recovery (ours): Algorithm 2 led the robot nowhere for 3 s; plan A* from here
+            # and follow that path for 4 s
+            self._replan(x, y)
+        if self.recover_left > 0 and self.rec_pts is not None:
+            self.recover_left -= 1
+            self.recover_k = int(dwa_progress(x, y, self.rec_pts, self.rec_cum,
+                                              self.recover_k, 2.0))
+            pts, cum, k = self.rec_pts, self.rec_cum, self.recover_k
+            net = -1.0
+        if local.shape[0] >= 2 and net >= self.min_reach_m:
+            path, pcum, kk = np.require(local, np.float64, ("C", "W")), lc, 0
+            self.on_line += 1
+        else:
+            path, pcum, kk = pts, cum, min(max(int(k), 0), pts.shape[0] - 1)
+            self.on_path += 1
+        cmd = obs.command
+        th = float(obs.heading)
+        # rotate to heading first (as Regulated Pure Pursuit does): constant-omega rollouts
+        # over the horizon wrap around and make turning on the spot a slow spiral
+        j = int(np.searchsorted(pcum, pcum[kk] + self.look_m))
+        j = min(max(j, kk + 1), path.shape[0] - 1)
+        err = _wrap(math.atan2(float(path[j, 1]) - y, float(path[j, 0]) - x) - th)
+        if abs(err) > self.rotate_rad:
+            return self._rotate(err)
+        a0, a1, _, _ = dwa_choose(self.problem.grid.occupied, self.f, x, y,
+                                  float(obs.heading), float(cmd[0]), float(cmd[1]), path, pcum,
+                                  kk, dpos, dvel, drad)
+        if a0 <= 0.0 and float(cmd[0]) <= 0.0 and abs(err) > 0.05:
+            # the window's best is to stand and turn: turn towards the local path at the rate
+            # from which the turn stops there (the window's long constant-omega rollouts
+            # would spin past it)
+            return self._rotate(err)
+        return np.array([float(a0), float(a1)])
+
+    def _rotate(self, err: float) -> np.ndarray:
+        rb = self.problem.robot
+        dt = float(self.f[0])
+        rate = min(abs(err) / dt, rb.max_yaw_rate_radps)
+        if math.isfinite(rb.max_yaw_accel_radps2):
+            rate = min(rate, math.sqrt(2.0 * rb.max_yaw_accel_radps2 * abs(err)))
+        self.rotations += 1
+        return np.array([0.0, rate if err > 0 else -rate])

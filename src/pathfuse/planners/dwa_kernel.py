@@ -14,6 +14,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
 from pathfuse.sweep import (
     arc_deviation_bound,
     disc_sweep_gaps,
@@ -28,6 +29,7 @@ __all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "N_D"]
  D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES) = range(26)
 N_D = 26
 SOFT = 0.3
+PASSIVE_COST = 20.0
 
 
 def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
@@ -117,6 +119,10 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
     rr = np.empty(1)
     pa = np.empty(2)
     pb = np.empty(2)
+    reach = np.empty(n_disc)
+    stop_s = dt + (speed / amax if math.isfinite(amax) and amax > 0.0 else 0.0)
+    for j in range(n_disc):
+        reach[j] = math.hypot(dvel[j, 0], dvel[j, 1]) * stop_s
     gmin = np.inf
     dmaxr = 0.0
     tc = np.inf
@@ -155,7 +161,9 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
             qb[0, 0] = dpos[j, 0] + dvel[j, 0] * t
             qb[0, 1] = dpos[j, 1] + dvel[j, 1] * t
             rr[0] = drad[j]
-            g = disc_sweep_gaps(pa, pb, radius, qa, qb, rr)[0] - e
+            # less how far the disc can come while the robot stops from here (so a pass
+            # that the shield's passive-safety test would refuse counts as a collision)
+            g = disc_sweep_gaps(pa, pb, radius, qa, qb, rr)[0] - e - reach[j]
             if g < gmin:
                 gmin = g
                 dmaxr = drad[j]
@@ -232,6 +240,17 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
               + f[D_WSPEED] * (f[D_VMAX] - v) / f[D_VMAX] + f[D_WOBS] * obs + f[D_WDYN] * dyn)
 
 
+@njit(cache=True, inline="always")
+def _passive_penalty(gap):
+    """The cost of a sample whose tick and stop come closer to a sensed disc than it can
+    reach at its present speed (the safety shield's passive-safety test,
+    :mod:`pathfuse.shield`): chosen only when every sample does, the one with the largest
+    gap first."""
+    if gap >= 0.0:
+        return 0.0
+    return PASSIVE_COST + 10.0 * min(-gap, 10.0)
+
+
 @njit(cache=True)
 def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     """The best command from the dynamic window.
@@ -275,6 +294,10 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     b0 = 0.0
     b1 = 0.0
     count = 0
+    n_disc = drad.shape[0]
+    dspeed = np.empty(n_disc)
+    for j in range(n_disc):
+        dspeed[j] = math.hypot(dvel[j, 0], dvel[j, 1])
     if f[D_HOLO] == 1.0:
         # velocity vectors: speeds x directions (3 w_samples of them, every 8 degrees by
         # default), within |u - u0| <= a dt
@@ -300,6 +323,9 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
                 sp = math.hypot(ux, uy)
                 hd = math.atan2(uy, ux) if sp > 0.0 else th
                 _rollout(occ, f, x, y, hd, sp, 0.0, pts, cum, k, jg, dpos, dvel, drad, out)
+                if out[1] == 1.0 and n_disc > 0:
+                    out[0] += _passive_penalty(holonomic_stop_disc_gap(
+                        x, y, ux, uy, dt, amax, f[D_RADIUS], dpos, dspeed, drad))
                 if out[1] == 1.0:
                     count += 1
                     if out[0] < best:
@@ -326,6 +352,9 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
             else:
                 w = min(max(0.0, wlo), whi)  # always try going straight
             _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out)
+            if out[1] == 1.0 and n_disc > 0:
+                out[0] += _passive_penalty(unicycle_stop_disc_gap(
+                    x, y, th, v, w, dt, amax, f[D_ALPHA], f[D_RADIUS], dpos, dspeed, drad))
             if out[1] == 1.0:
                 count += 1
                 if out[0] < best:

@@ -264,7 +264,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
     sensed[0, obs.obstacles.ids] = True
 
     problem = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius,
-                             clearance_m=sc.robot.clearance, robot=model)
+                             clearance_m=model.clearance_m, robot=model)
     warm(spec)
     from pathfuse.shield import warmup_shield
 

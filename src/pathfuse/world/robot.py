@@ -49,8 +49,9 @@ class RobotSpec:
     min_speed : float
         Diff-drive: the lowest linear speed (m/s, <= 0; negative allows
         reversing).
-    clearance : float
-        Soft safety margin beyond the radius (m; ours; 0 = off).
+    clearance : float or None
+        Soft safety margin beyond the radius (m; ours; 0 = off); None: 0.05 m
+        for a diff-drive robot, 0 for a holonomic one.
     heading : float or None
         Initial heading (rad; None: facing the goal).
     shield : bool
@@ -66,7 +67,7 @@ class RobotSpec:
     max_yaw_rate: float | None = None
     max_yaw_accel: float | None = None
     min_speed: float = 0.0
-    clearance: float = 0.0
+    clearance: float | None = None
     heading: float | None = None
     shield: bool = True
 
@@ -74,8 +75,10 @@ class RobotSpec:
         """The :class:`~pathfuse.robot.RobotModel` of this block (defaults filled in)."""
         kw: dict[str, Any] = {"radius_m": self.radius, "max_speed_mps": self.max_speed,
                               "sensing_radius_m": self.sensing_radius,
-                              "min_speed_mps": self.min_speed, "clearance_m": self.clearance,
+                              "min_speed_mps": self.min_speed,
                               "heading_rad": self.heading, "shield": self.shield}
+        if self.clearance is not None:
+            kw["clearance_m"] = self.clearance
         for key, attr in (("max_accel_mps2", "max_accel"),
                           ("max_yaw_rate_radps", "max_yaw_rate"),
                           ("max_yaw_accel_radps2", "max_yaw_accel")):
@@ -124,7 +127,7 @@ def parse_robot(v: Any, error: type[ConfigError] = ConfigError) -> RobotSpec:
         max_yaw_rate=opt("max_yaw_rate", gt=0),
         max_yaw_accel=opt("max_yaw_accel", gt=0),
         min_speed=num("min_speed", le=0),
-        clearance=num("clearance", ge=0),
+        clearance=opt("clearance", ge=0),
         heading=opt("heading"),
         shield=validate.flag(m.get("shield", d.shield), "robot.shield", error),
     )

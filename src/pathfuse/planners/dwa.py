@@ -124,6 +124,11 @@ class DWAParams(GlobalAStarParams):
                                    help="replan the global A* path from the robot's position, "
                                         "around the sensed discs, this often (Nav2's default "
                                         "1 Hz; 0 = never)")
+    passive_safety: bool = param(True, help="plan for the safety shield's passive safety "
+                                            "(ours): a pass closer to a sensed disc than it "
+                                            "can travel while the robot stops counts as a "
+                                            "collision; false: dwa's constant-velocity "
+                                            "prediction alone")
     stall_steps: int = param(50, ge=1, help="offline: look-back of the stall test, in ticks")
     stall_distance_m: float = param(0.05, gt=0, unit="m",
                                     help="offline: a net move below this over stall_steps "
@@ -166,7 +171,8 @@ class DWAController(Controller):
             self.clear_m, max(problem.clearance_m, rb.clearance_m), p.horizon_s, p.sim_step_s,
             p.v_samples, p.w_samples, p.path_weight, p.goal_weight, p.heading_weight,
             p.speed_weight, p.obstacle_weight, p.moving_weight, p.obstacle_range_m,
-            p.lookahead_m, p.inflation_decay_m, not rb.is_diff_drive, ox, oy, g.resolution)
+            p.lookahead_m, p.inflation_decay_m, not rb.is_diff_drive, ox, oy, g.resolution,
+            p.passive_safety)
         self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
         self.no_choice = 0
         self._sensed = _NO_DISCS

@@ -26,20 +26,20 @@ __all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "N_D"]
 
 (D_DT, D_VMIN, D_VMAX, D_AMAX, D_WMAX, D_ALPHA, D_RADIUS, D_CLEAR, D_MARGIN, D_HORIZON,
  D_SIMDT, D_NV, D_NW, D_WPATH, D_WGOAL, D_WHEAD, D_WSPEED, D_WOBS, D_WDYN, D_RANGE,
- D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES) = range(26)
-N_D = 26
+ D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES, D_PASSIVE) = range(27)
+N_D = 27
 SOFT = 0.3
 PASSIVE_COST = 20.0
 
 
 def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
              n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
-             decay, holonomic, ox, oy, res):
+             decay, holonomic, ox, oy, res, passive=True):
     """The settings array of :func:`dwa_choose`."""
     f = np.zeros(N_D)
     vals = (dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
             n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
-            decay, 1.0 if holonomic else 0.0, ox, oy, res)
+            decay, 1.0 if holonomic else 0.0, ox, oy, res, 1.0 if passive else 0.0)
     for i, v in enumerate(vals):
         f[i] = float(v)
     return f
@@ -121,6 +121,8 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
     pb = np.empty(2)
     reach = np.empty(n_disc)
     stop_s = dt + (speed / amax if math.isfinite(amax) and amax > 0.0 else 0.0)
+    if f[D_PASSIVE] != 1.0:
+        stop_s = 0.0
     for j in range(n_disc):
         reach[j] = math.hypot(dvel[j, 0], dvel[j, 1]) * stop_s
     gmin = np.inf
@@ -294,7 +296,7 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     b0 = 0.0
     b1 = 0.0
     count = 0
-    n_disc = drad.shape[0]
+    n_disc = drad.shape[0] if f[D_PASSIVE] == 1.0 else 0
     dspeed = np.empty(n_disc)
     for j in range(n_disc):
         dspeed[j] = math.hypot(dvel[j, 0], dvel[j, 1])

@@ -128,4 +128,7 @@ def test_dwa_dodges_a_head_on_disc_where_astar_walks_into_it():
     assert simulate(sc, planner="astar", robot=robot).status is Status.COLLISION
     ep = simulate(sc, planner="dwa", robot=robot)
     assert ep.status is Status.SUCCESS, ep.message
-    assert ep.min_obstacle_distance_m > 0
+    # planning for the shield's passive safety, it steps aside early and wide (it passed
+    # within 1 mm before, and under the shield was stopped in the disc's way and hit)
+    assert ep.min_obstacle_distance_m > 0.1
+    assert ep.shield_counts["asked"] == ep.n_ticks

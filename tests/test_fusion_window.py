@@ -59,10 +59,10 @@ def test_streamline_looks_ahead_without_moving_the_fusion():
 
 def test_static_maps_reached_without_collision():
     """The paper's map family with a diff-drive robot and no disc: the fusion in velocity
-    space never collides and reaches the goal in 7 of the first 10 scenarios with the
-    diff-drive robot's default 5 cm margin (9 of 10 without it: the margin leaves the
-    field fewer ways through these 1 m cells; scenario 1 needs the stall recovery); the
-    conversion of the move, for comparison, never collides either."""
+    space never collides and reaches the goal in 9 of the first 10 scenarios (7 of 10 with
+    a 5 cm safety margin: it leaves the field fewer ways through these 1 m cells; scenario
+    1 needs the stall recovery); the conversion of the move, for comparison, never
+    collides either."""
     reached = 0
     for index, sc in enumerate(_scenarios(10)):
         ep = simulate(sc, planner="fusion", seed=index)
@@ -71,7 +71,7 @@ def test_static_maps_reached_without_collision():
         off = simulate(sc, planner={"name": "fusion", "params": {"velocity_space": False}},
                        seed=index)
         assert off.status is not Status.COLLISION
-    assert reached >= 7
+    assert reached >= 9
 
 
 def test_recovery_replans_from_where_the_robot_stands():

@@ -55,9 +55,8 @@ KINDS = ("holonomic", "diff-drive")
 """The kinematic models."""
 
 DIFF_DRIVE_DEFAULTS = {"max_accel_mps2": 2.0, "max_yaw_rate_radps": 2.0,
-                       "max_yaw_accel_radps2": 4.0, "clearance_m": 0.05}
-"""The limits a diff-drive robot gets when none is given (a small indoor base), and its
-soft safety margin (5 cm: kept where the world leaves room, see the README)."""
+                       "max_yaw_accel_radps2": 4.0}
+"""The limits a diff-drive robot gets when none is given (a small indoor base)."""
 
 
 @dataclass(frozen=True)
@@ -81,8 +80,7 @@ class RobotModel:
     min_speed_mps : float
         Diff-drive only: the lowest ``v`` (<= 0; negative allows reversing).
     clearance_m : float
-        The soft safety margin beyond the radius (>= 0; 0 = off; a diff-drive
-        robot made by :meth:`diff_drive` gets 0.05 m unless given).
+        The soft safety margin beyond the radius (>= 0; 0 = off).
     heading_rad : float or None
         Initial heading (None: facing the goal).
     shield : bool

@@ -50,8 +50,8 @@ class RobotSpec:
         Diff-drive: the lowest linear speed (m/s, <= 0; negative allows
         reversing).
     clearance : float or None
-        Soft safety margin beyond the radius (m; ours; 0 = off); None: 0.05 m
-        for a diff-drive robot, 0 for a holonomic one.
+        Soft safety margin beyond the radius (m; ours; 0 = off); None: the
+        model's default (0).
     heading : float or None
         Initial heading (rad; None: facing the goal).
     shield : bool

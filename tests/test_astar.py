@@ -3,6 +3,7 @@ path validity, statuses, budgets, buffer reuse and determinism."""
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import math
 import os
@@ -24,6 +25,7 @@ from pathfuse import Budget, ConfigError, GridMap, MapError, QueryError, Status
 from pathfuse.io.movingai import read_movingai
 from pathfuse.io.scenario import read_scen, scen_map_name
 from pathfuse.planners.astar import AStarParams, FollowController
+from pathfuse.planners.params import PursuitParams
 from pathfuse.planners.registry import get_planner
 from pathfuse.planners.run import warm
 from pathfuse.problem import Problem
@@ -332,7 +334,8 @@ def test_params_validation():
                        match=r"^astar\.corner_cutting: must be true or false, got 'yes'$"):
         pathfuse.plan(g, (0.5, 0.5), (1.5, 1.5), corner_cutting="yes")
     with pytest.raises(ConfigError, match=r"^astar\.heuristc: unknown parameter "
-                                          r"\(parameters: heuristic, corner_cutting\)$"):
+                                          r"\(parameters: heuristic, corner_cutting, "
+                                          r"lookahead_time_s, .*, clear_carrot\)$"):
         pathfuse.plan(g, (0.5, 0.5), (1.5, 1.5), heuristc="octile")
     # the robot radius is a keyword of plan(), not a parameter
     with pytest.raises(ConfigError, match=r"^robot_radius_m: must be a finite number >= 0"):
@@ -354,7 +357,9 @@ def test_registry_entry():
     assert spec.controller is FollowController and spec.function is None
     assert spec.params_cls is AStarParams and spec.global_planner == "astar"
     assert spec.uses_astar and spec.offline and spec.online and spec.description
-    assert spec.defaults() == {"heuristic": "euclidean", "corner_cutting": False}
+    # the search's parameters, then the diff-drive path follower's (planners/rpp.py)
+    assert spec.defaults() == {"heuristic": "euclidean", "corner_cutting": False,
+                               **dataclasses.asdict(PursuitParams())}
     warm(spec)
     # the older name of the same planner
     assert get_planner("astar-follow") is spec

@@ -5,7 +5,8 @@ Each is a *global planner* plus the ``follow`` controller (as ``astar`` is):
 the global planner makes a path of straight sight lines from the start point
 to the goal point; offline :func:`pathfuse.plan` returns it, online
 :func:`pathfuse.simulate` walks it at full speed, blind to moving discs (as
-``astar`` does).  ``Budget.max_iterations`` caps the global search's
+``astar`` does; on a diff-drive robot with Regulated Pure Pursuit,
+:mod:`pathfuse.planners.rpp`).  ``Budget.max_iterations`` caps the global search's
 expansions.
 
 ``thetastar``
@@ -52,7 +53,7 @@ from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.astar import FollowController
 from pathfuse.planners.base import Outcome
 from pathfuse.planners.global_astar import GlobalPlan, plan_global, snap_cell
-from pathfuse.planners.params import Checked, GlobalAStarParams
+from pathfuse.planners.params import GlobalAStarParams, PursuitParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
 from pathfuse.result import Status
@@ -65,19 +66,22 @@ ANY_ANGLE = ("thetastar", "lazy-thetastar", "astar-smooth", "shortest")
 
 
 @dataclass(frozen=True)
-class ThetaStarParams(Checked):
-    """Parameters of ``thetastar`` and ``lazy-thetastar`` (none: the heuristic is the
-    Euclidean distance, the corner rule pathfuse's)."""
+class ThetaStarParams(PursuitParams):
+    """Parameters of ``thetastar`` and ``lazy-thetastar``: the follower's on a diff-drive
+    robot (the search has none: the heuristic is the Euclidean distance, the corner rule
+    pathfuse's)."""
 
 
 @dataclass(frozen=True)
-class SmoothParams(GlobalAStarParams):
-    """Parameters of ``astar-smooth``: the heuristic of its A*."""
+class SmoothParams(PursuitParams, GlobalAStarParams):
+    """Parameters of ``astar-smooth``: the heuristic of its A*, the follower's on a
+    diff-drive robot."""
 
 
 @dataclass(frozen=True)
-class ShortestParams(Checked):
-    """Parameters of ``shortest`` (none)."""
+class ShortestParams(PursuitParams):
+    """Parameters of ``shortest``: the follower's on a diff-drive robot (the search has
+    none)."""
 
 
 @dataclass(eq=False)
@@ -184,7 +188,8 @@ class PathController(FollowController):
     # An any-angle path is taut: it turns where it touches the robot's clearance around an
     # obstacle corner, so a move across a corner (from a point before it to one after it)
     # would come closer than the radius.  Stopping on each corner costs at most one tick
-    # per corner, and these paths have few.
+    # per corner, and these paths have few.  (A holonomic robot's walk; a diff-drive robot
+    # follows the path with Regulated Pure Pursuit, planners/rpp.py.)
     stop_at_corners: ClassVar[bool] = True
 
     def run(self, deadline: float | None) -> Outcome:
@@ -194,11 +199,12 @@ class PathController(FollowController):
 
     @classmethod
     def warmup(cls) -> None:
+        super().warmup()
         _warm(cls.kind)
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:
-        return _kernels(cls.kind)
+        return (*super().kernels(), *_kernels(cls.kind))
 
 
 class ThetaStarController(PathController):

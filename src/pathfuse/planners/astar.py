@@ -9,14 +9,19 @@
     ``Budget.max_iterations`` caps the expansions.  Online,
     :func:`pathfuse.simulate` walks the path (start, centres, goal) at full
     speed, blind to moving discs: the paper's "A* cannot handle dynamic
-    obstacles", made measurable.  ``astar-follow`` is an older name of it.
+    obstacles", made measurable.  On a diff-drive robot it follows the path
+    with Regulated Pure Pursuit (:mod:`pathfuse.planners.rpp`, Nav2's
+    follower), still blind to moving discs.  ``astar-follow`` is an older
+    name of it.
 ``astar-replan``
     Online, A* replanned every ``replan_period_s`` (default 1 s, as Nav2's
     default behaviour tree replans at 1 Hz) on the robot's c-space with the
     sensed discs rasterised as blocked cells (grown by the robot radius and
-    ``margin_m``), the path walked at full speed in between; with no path
-    the robot waits for the next replan.  Offline, on a static map, every
-    replan gives the first path, so ``plan()`` returns the ``astar`` path.
+    ``margin_m``), the path walked at full speed in between (on a
+    diff-drive robot followed by Regulated Pure Pursuit, each replanned path
+    from its start); with no path the robot waits for the next replan.
+    Offline, on a static map, every replan gives the first path, so
+    ``plan()`` returns the ``astar`` path.
 
 Examples
 --------
@@ -48,8 +53,9 @@ from numba import njit
 
 from pathfuse.planners.base import Controller, Observed, Outcome
 from pathfuse.planners.global_astar import plan_global
-from pathfuse.planners.params import GlobalAStarParams
+from pathfuse.planners.params import GlobalAStarParams, PursuitParams
 from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.planners.rpp import RegulatedPurePursuit, rpp_step, warmup_rpp
 from pathfuse.problem import Problem
 from pathfuse.result import Status
 from pathfuse.validate import param
@@ -58,23 +64,33 @@ __all__ = ["AStarParams", "ReplanParams", "FollowController", "ReplanController"
 
 
 @dataclass(frozen=True)
-class AStarParams(GlobalAStarParams):
-    """Parameters of the ``astar`` planner."""
-
+class _AStarSearch(GlobalAStarParams):
     corner_cutting: bool = param(False, help="allow a diagonal move past a blocked orthogonal "
                                              "neighbour (false: the MovingAI rule, and safe for "
                                              "a robot)")
 
 
 @dataclass(frozen=True)
-class ReplanParams(GlobalAStarParams):
-    """Parameters of ``astar-replan``."""
-
+class _Replanning(GlobalAStarParams):
     replan_period_s: float = param(1.0, gt=0, unit="s",
                                    help="seconds between replans online (1 s = Nav2's 1 Hz)")
     margin_m: float = param(0.0, ge=0, unit="m",
                             help="extra clearance around each sensed disc when it is "
                                  "rasterised")
+
+
+# the follower's parameters come last (their base class first: dataclass fields are
+# collected from the last base class to the first)
+@dataclass(frozen=True)
+class AStarParams(PursuitParams, _AStarSearch):
+    """Parameters of the ``astar`` planner: its search, and its path follower's on a
+    diff-drive robot (:class:`~pathfuse.planners.params.PursuitParams`)."""
+
+
+@dataclass(frozen=True)
+class ReplanParams(PursuitParams, _Replanning):
+    """Parameters of ``astar-replan``: its search and replanning, and its path follower's
+    on a diff-drive robot (:class:`~pathfuse.planners.params.PursuitParams`)."""
 
 
 def _point_at(path: np.ndarray, cum: np.ndarray, s: float) -> np.ndarray:
@@ -92,13 +108,15 @@ def _cumlen(path: np.ndarray) -> np.ndarray:
 
 
 class FollowController(Controller):
-    """Walk the global path at full speed (offline: return it as planned)."""
+    """Walk the global path at full speed (offline: return it as planned); on a diff-drive
+    robot, follow it with Regulated Pure Pursuit (:mod:`pathfuse.planners.rpp`)."""
 
     name = "astar"
     label = "follow the path"
     search_budget: ClassVar[bool] = True
     #: End a tick's move at the path's next corner instead of cutting across it (the
-    #: any-angle followers: their taut paths touch the robot's clearance at the corners).
+    #: any-angle followers: their taut paths touch the robot's clearance at the corners;
+    #: a holonomic robot's walk only).
     stop_at_corners: ClassVar[bool] = False
 
     def __init__(self, problem: Problem, params: Any, plan: Any = None, **kw: Any) -> None:
@@ -108,6 +126,17 @@ class FollowController(Controller):
             self._cum = _cumlen(self._path)
             self._s = 0.0
             self._step = float(self.max_speed) * float(self.dt)  # type: ignore[arg-type]
+        self._rpp: RegulatedPurePursuit | None = None
+        rb = problem.robot
+        if self.online and rb is not None and rb.is_diff_drive:
+            dt, top = float(self.dt), float(self.max_speed)  # type: ignore[arg-type]
+            self._rpp = RegulatedPurePursuit(problem, params, dt, top)
+
+    @property
+    def acts_unicycle(self) -> bool:
+        """On a diff-drive robot :meth:`act` answers ``(v, omega)`` (Regulated Pure
+        Pursuit)."""
+        return self._rpp is not None
 
     def run(self, deadline: float | None) -> Outcome:
         gp = self.plan
@@ -116,6 +145,8 @@ class FollowController(Controller):
         return Outcome(Status.SUCCESS, gp.points, 0, 0.0, gp.message, info, gp.length_m)
 
     def act(self, obs: Observed) -> np.ndarray:
+        if self._rpp is not None:
+            return self._rpp.command(obs, self._path)
         cum = self._cum
         s = min(self._s + self._step, float(cum[-1]))
         if self.stop_at_corners:
@@ -125,6 +156,14 @@ class FollowController(Controller):
         self._s = s
         target = _point_at(self._path, cum, s)
         return (target - obs.position) / float(self.dt)  # type: ignore[no-any-return, arg-type]
+
+    @classmethod
+    def kernels(cls) -> Sequence[Any]:
+        return (rpp_step,)
+
+    @classmethod
+    def warmup(cls) -> None:
+        warmup_rpp()
 
 
 @njit(cache=True)
@@ -191,10 +230,11 @@ class ReplanController(FollowController):
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:
-        return (_rasterise_discs,)
+        return (*super().kernels(), _rasterise_discs)
 
     @classmethod
     def warmup(cls) -> None:
+        super().warmup()
         occ = np.zeros((3, 4), dtype=np.bool_)
         _rasterise_discs(occ, 0.0, 0.0, 1.0, np.ones((1, 2)), np.ones(1), 0.2)
 

@@ -13,10 +13,11 @@ from dataclasses import dataclass
 
 from pathfuse.field.forces import K_ATT, K_REP, RHO0_M
 from pathfuse.field.repulsion import BOUNDARY_OFFSET_M
+from pathfuse.result import ConfigError
 from pathfuse.search.astar import HEURISTICS
 from pathfuse.validate import check_fields, param
 
-__all__ = ["Checked", "GlobalAStarParams", "FieldParams", "DiscParams"]
+__all__ = ["Checked", "GlobalAStarParams", "FieldParams", "DiscParams", "PursuitParams"]
 
 
 @dataclass(frozen=True)
@@ -95,3 +96,64 @@ class DiscParams(Checked):
                                "past it (ours, not the paper's; 0 = off)")
     dodge: bool = param(True, help="when a disc pins the robot against a wall, take the clear "
                                    "move that most increases the gap (ours; false = off)")
+
+
+_DD = " (diff-drive robot online; no effect on a holonomic robot)"
+
+
+@dataclass(frozen=True)
+class PursuitParams(Checked):
+    """Regulated Pure Pursuit, the path followers' controller on a diff-drive robot
+    (:mod:`pathfuse.planners.rpp`; Nav2's defaults unless the help says otherwise)."""
+
+    lookahead_time_s: float = param(
+        1.5, gt=0, unit="s",
+        help="lookahead = |v| x this, clipped to [min_lookahead_m, max_lookahead_m] "
+             "(Nav2's lookahead_time)" + _DD)
+    min_lookahead_m: float = param(0.3, gt=0, unit="m",
+                                   help="shortest lookahead (Nav2's min_lookahead_dist)" + _DD)
+    max_lookahead_m: float = param(0.9, gt=0, unit="m",
+                                   help="longest lookahead (Nav2's max_lookahead_dist)" + _DD)
+    rotate_to_heading_min_angle_rad: float = param(
+        0.785, gt=0, le=3.1416, unit="rad",
+        help="beyond this bearing of the carrot the robot brakes and turns on the spot "
+             "(Nav2's rotate_to_heading_min_angle)" + _DD)
+    regulated_min_radius_m: float = param(
+        0.9, ge=0, unit="m",
+        help="on a pursuit arc of smaller radius the speed scales by radius / this "
+             "(Nav2's regulated_linear_scaling_min_radius; 0 = off)" + _DD)
+    regulated_min_speed_mps: float = param(
+        0.25, ge=0, unit="m/s",
+        help="the curvature and proximity heuristics never slow the robot below this "
+             "(Nav2's regulated_linear_scaling_min_speed)" + _DD)
+    proximity_distance_m: float = param(
+        0.1, ge=0, unit="m",
+        help="closer than this to an obstacle (the exact gap between the robot disc and the "
+             "map) the speed scales by gap / this (0 = off); Nav2's cost_scaling_dist, 0.3 m "
+             "from the robot's centre with gain 1, is a gap of 0.1 m for pathfuse's default "
+             "0.2 m robot" + _DD)
+    approach_distance_m: float = param(
+        0.6, ge=0, unit="m",
+        help="within this remaining distance to the goal the speed scales by distance / this "
+             "(Nav2's approach_velocity_scaling_dist; 0 = off); the robot also never goes "
+             "faster than it can brake to the goal" + _DD)
+    min_approach_speed_mps: float = param(
+        0.05, gt=0, unit="m/s",
+        help="the approach scaling keeps at least this speed (Nav2's "
+             "min_approach_linear_velocity)" + _DD)
+    pose_search_distance_m: float = param(
+        1.5, gt=0, unit="m",
+        help="the closest path point is searched this far along the path ahead of the "
+             "last one, so progress never jumps back nor across a loop (Nav2's "
+             "max_robot_pose_search_dist, half its default 3 m local costmap)" + _DD)
+    clear_carrot: bool = param(
+        True, help="shorten the lookahead until the disc swept along the arc to the carrot "
+                   "keeps the robot's radius from the map (ours; Nav2's collision check "
+                   "instead stops the robot, and its paths keep away from walls by the "
+                   "costmap's inflation, which pathfuse's shortest paths do not)" + _DD)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.max_lookahead_m < self.min_lookahead_m:
+            raise ConfigError(f"max_lookahead_m: must be >= min_lookahead_m "
+                              f"({self.min_lookahead_m:g}), got {self.max_lookahead_m!r}")

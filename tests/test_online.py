@@ -393,7 +393,7 @@ def test_planners_get_the_static_context_and_current_observations_only():
         {"grid", "start", "goal", "robot_radius_m", "budget", "start_cell", "goal_cell",
          "clearance_m", "robot"}
     pb = spy.problem
-    assert pb.robot == sc.robot.to_model() and pb.clearance_m == sc.robot.clearance
+    assert pb.robot == sc.robot.to_model() and pb.clearance_m == sc.robot.to_model().clearance_m
     assert pb.grid is sc.grid and pb.start == sc.start and pb.goal == sc.goal
     assert pb.robot_radius_m == sc.robot.radius
     assert (spy.dt, spy.max_speed, spy.online, spy.plan) == (sc.dt, sc.robot.max_speed, True,

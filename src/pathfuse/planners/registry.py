@@ -144,7 +144,7 @@ def register_function(name: str, func: Callable[..., Any], params_cls: type,
 
 
 _BUILTIN = ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7", "astar-smooth", "thetastar",
-            "lazy-thetastar", "shortest", "dwa")
+            "lazy-thetastar", "shortest", "dwa", "mppi")
 
 
 def planner_names() -> list[str]:
@@ -212,5 +212,5 @@ def _load_builtin() -> None:
     _LOADED = True
     import importlib
 
-    for mod in ("astar", "apf", "fusion", "refs", "anyangle", "dwa"):
+    for mod in ("astar", "apf", "fusion", "refs", "anyangle", "dwa", "mppi"):
         importlib.import_module(f"pathfuse.planners.{mod}")

@@ -1,0 +1,484 @@
+"""The numba kernel of Model Predictive Path Integral control (see :mod:`pathfuse.planners.mppi`).
+
+:func:`mppi_optimise` runs one MPPI iteration: it builds the batch of control
+sequences (the nominal one, two pure-pursuit guides along the path, a braking
+sequence and the nominal plus the given Gaussian noise, each clipped step by
+step to the robot's limits and acceleration windows), rolls each out (exact
+unicycle arcs or straight moves), scores it with the critics and replaces the
+nominal sequence with the softmax-weighted mean of the batch (or with the
+fast guide when that scores better, unless switched off).  Settings travel in
+one float array (indices ``M_*``) filled by :func:`pack_mppi`.
+
+The static clearance of a point is read from a lower-bound field (metres from
+each cell centre of a fine lattice to the nearest occupied square, less half
+a lattice cell's diagonal; see :func:`pathfuse.planners.mppi.clearance_field`):
+``field[c] - |p - c|`` is a lower bound of the distance from ``p`` to the
+occupied squares (the distance is 1-Lipschitz).  Between two rollout points
+``a`` and ``b`` at least ``c`` away from every obstacle, the whole segment is
+at least ``sqrt(c^2 - |ab|^2 / 4)`` away; an arc leaves its chord by at most
+``|v omega| h^2 / 8``.  Where these bounds say a step comes closer than the
+radius, the chord's exact distance (:func:`pathfuse.sweep.segment_static_distance`)
+less that bound decides.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from pathfuse.sweep import segment_static_distance, unicycle_pose
+
+__all__ = ["mppi_optimise", "pack_mppi", "path_inflation", "N_M", "static_gap"]
+
+(M_DT, M_MDT, M_VMIN, M_VMAX, M_AMAX, M_WMAX, M_ALPHA, M_HOLO, M_RADIUS, M_MARGIN,
+ M_OX, M_OY, M_XMAX, M_YMAX, M_FRES, M_TEMP, M_WCOLL, M_WOBS, M_INFL_R, M_INFL_K,
+ M_WALIGN, M_WPROG, M_WGOAL, M_GOALD, M_WHEAD, M_LOOK, M_WDCOLL, M_WDPROX, M_DDECAY,
+ M_WSMOOTH, M_WFWD, M_STD0, M_STD1, M_SEGMAX, M_GX, M_GY, M_PEAK, M_RES, M_SLOW,
+ M_KEEP) = range(40)
+N_M = 40
+MARGIN_COST = 1.0
+"""Inside the robot's safety margin the obstacle cost grows by this much per margin width."""
+N_FIXED = 4
+"""Samples that are not noise: the nominal sequence, the two guides, the braking sequence."""
+
+
+def pack_mppi(dt, model_dt, vmin, vmax, amax, wmax, alpha, holonomic, radius, margin, ox, oy,
+              xmax, ymax, field_res, temperature, w_coll, w_obs, infl_radius, infl_k, w_align,
+              w_prog, w_goal, goal_dist, w_head, lookahead, w_dcoll, w_dprox, disc_decay,
+              w_smooth, w_fwd, std0, std1, seg_max, gx, gy, w_peak, res, slow, keep_guide):
+    """The settings array of :func:`mppi_optimise`."""
+    vals = (dt, model_dt, vmin, vmax, amax, wmax, alpha, 1.0 if holonomic else 0.0, radius,
+            margin, ox, oy, xmax, ymax, field_res, temperature, w_coll, w_obs, infl_radius,
+            infl_k, w_align, w_prog, w_goal, goal_dist, w_head, lookahead, w_dcoll, w_dprox,
+            disc_decay, w_smooth, w_fwd, std0, std1, seg_max, gx, gy, w_peak, res, slow,
+            1.0 if keep_guide else 0.0)
+    f = np.zeros(N_M)
+    for i, v in enumerate(vals):
+        f[i] = float(v)
+    return f
+
+
+@njit(cache=True, inline="always")
+def _wrap(a):
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit(cache=True)
+def static_gap(field, f, x, y):
+    """Lower bounds of the distances from ``(x, y)`` to the occupied squares and (exact) to
+    the map's outside: ``(squares, edge)``, the edge one negative outside the map (and the
+    squares' one taken from the nearest lattice cell)."""
+    ox = f[M_OX]
+    oy = f[M_OY]
+    de = min(x - ox, f[M_XMAX] - x, y - oy, f[M_YMAX] - y)
+    r = f[M_FRES]
+    h, w = field.shape
+    c = min(max(int(math.floor((x - ox) / r)), 0), w - 1)
+    q = min(max(int(math.floor((y - oy) / r)), 0), h - 1)
+    d = field[q, c] - math.hypot(x - (ox + (c + 0.5) * r), y - (oy + (q + 0.5) * r))
+    return d, de
+
+
+@njit(cache=True)
+def path_inflation(field, f, pts, relative):
+    """The inflation cost ``exp(-factor x gap)`` at each path point (the baseline the rollouts'
+    obstacle critic is measured against); zeros when ``relative`` is false."""
+    out = np.zeros(pts.shape[0])
+    if not relative:
+        return out
+    for i in range(pts.shape[0]):
+        gap = static_gap(field, f, pts[i, 0], pts[i, 1])[0] - f[M_RADIUS]
+        if gap < f[M_INFL_R]:
+            out[i] = math.exp(-f[M_INFL_K] * gap)
+    return out
+
+
+@njit(cache=True, inline="always")
+def _clip_uni(pv, pw, v, w, h, f):
+    a = f[M_AMAX] * h
+    b = f[M_ALPHA] * h
+    v = min(max(v, max(f[M_VMIN], pv - a)), min(f[M_VMAX], pv + a))
+    w = min(max(w, max(-f[M_WMAX], pw - b)), min(f[M_WMAX], pw + b))
+    return v, w
+
+
+@njit(cache=True, inline="always")
+def _clip_holo(px, py, ux, uy, h, f):
+    vmax = f[M_VMAX]
+    s = math.hypot(ux, uy)
+    if s > vmax:
+        ux *= vmax / s * (1.0 - 1e-12)
+        uy *= vmax / s * (1.0 - 1e-12)
+    lim = f[M_AMAX] * h
+    if math.isfinite(lim):
+        dx = ux - px
+        dy = uy - py
+        n = math.hypot(dx, dy)
+        if n > lim:  # onto the window's edge, a hair inside (the world never clips it)
+            ux = px + dx * (lim / n) * (1.0 - 1e-12)
+            uy = py + dy * (lim / n) * (1.0 - 1e-12)
+    return ux, uy
+
+
+@njit(cache=True)
+def _clip_sequence(seq, f, c0, c1):
+    """Clip a sequence in place, step by step, to the limits and the acceleration windows
+    (the first step's window is the tick's, the others the model step's)."""
+    p0 = c0
+    p1 = c1
+    holo = f[M_HOLO] == 1.0
+    for t in range(seq.shape[0]):
+        h = f[M_DT] if t == 0 else f[M_MDT]
+        if holo:
+            a, b = _clip_holo(p0, p1, seq[t, 0], seq[t, 1], h, f)
+        else:
+            a, b = _clip_uni(p0, p1, seq[t, 0], seq[t, 1], h, f)
+        seq[t, 0] = a
+        seq[t, 1] = b
+        p0 = a
+        p1 = b
+
+
+@njit(cache=True)
+def _track(px, py, pts, cum, j, k0, fwd, back):
+    """The nearest path segment to ``(px, py)`` around segment ``j`` (never before ``k0``):
+    ``(segment, distance, fraction along it)``."""
+    m = pts.shape[0]
+    if m == 1:
+        return 0, math.hypot(px - pts[0, 0], py - pts[0, 1]), 0.0
+    lo = j
+    while lo > k0 and cum[j] - cum[lo - 1] <= back:
+        lo -= 1
+    hi = j
+    while hi < m - 2 and cum[hi + 1] - cum[j] <= fwd:
+        hi += 1
+    best = j
+    bd = np.inf
+    bt = 0.0
+    for s in range(lo, hi + 1):
+        ax = pts[s, 0]
+        ay = pts[s, 1]
+        vx = pts[s + 1, 0] - ax
+        vy = pts[s + 1, 1] - ay
+        l2 = vx * vx + vy * vy
+        tt = 0.0
+        if l2 > 0.0:
+            tt = min(max(((px - ax) * vx + (py - ay) * vy) / l2, 0.0), 1.0)
+        d = math.hypot(px - (ax + tt * vx), py - (ay + tt * vy))
+        if d < bd:
+            bd = d
+            best = s
+            bt = tt
+    return best, bd, bt
+
+
+@njit(cache=True)
+def _point_at(pts, cum, s):
+    """The path point at arc length ``s`` (clamped to the path)."""
+    m = pts.shape[0]
+    if s >= cum[m - 1]:
+        return pts[m - 1, 0], pts[m - 1, 1]
+    if s <= 0.0:
+        return pts[0, 0], pts[0, 1]
+    lo = 0
+    hi = m - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if cum[mid] <= s:
+            lo = mid
+        else:
+            hi = mid
+    seg = cum[hi] - cum[lo]
+    u = (s - cum[lo]) / seg if seg > 0.0 else 0.0
+    return (pts[lo, 0] + u * (pts[hi, 0] - pts[lo, 0]),
+            pts[lo, 1] + u * (pts[hi, 1] - pts[lo, 1]))
+
+
+@njit(cache=True)
+def _guide(seq, f, field, x, y, th, c0, c1, pts, cum, k0, look, vslow):
+    """A pure-pursuit sequence (ours): towards a carrot ``look`` of path ahead, turning as
+    fast as the heading can still stop, slowing to stop at the goal.  With ``vslow > 0`` its
+    speed is regulated by the clearance, as Nav2's regulated pure pursuit does: the limit
+    times ``gap / inflation_radius_m``, at least ``vslow``."""
+    vmax = f[M_VMAX]
+    px = x
+    py = y
+    pth = th
+    p0 = c0
+    p1 = c1
+    j = k0
+    holo = f[M_HOLO] == 1.0
+    amax = f[M_AMAX]
+    alpha = f[M_ALPHA]
+    gx = f[M_GX]
+    gy = f[M_GY]
+    fwd = vmax * max(f[M_DT], f[M_MDT]) + 2.0 * f[M_SEGMAX]
+    for t in range(seq.shape[0]):
+        h = f[M_DT] if t == 0 else f[M_MDT]
+        j, _, tt = _track(px, py, pts, cum, j, k0, fwd, 2.0 * f[M_SEGMAX])
+        s = cum[j] + tt * (cum[min(j + 1, cum.shape[0] - 1)] - cum[j])
+        cx, cy = _point_at(pts, cum, s + look)
+        dg = math.hypot(gx - px, gy - py)
+        vcap = vmax
+        if math.isfinite(amax):
+            # the speed from which braking in steps of a h stops at the goal
+            vcap = min(vmax, amax * (math.sqrt(0.25 * h * h + 2.0 * dg / amax) - 0.5 * h))
+        if vslow > 0.0:
+            gap = static_gap(field, f, px, py)[0] - f[M_RADIUS]
+            vcap = min(vcap, max(vslow, vmax * gap / f[M_INFL_R]))
+        behind = (cx == gx and cy == gy and
+                  (gx - px) * math.cos(pth) + (gy - py) * math.sin(pth) <= 0.0)
+        if holo:
+            dx = cx - px
+            dy = cy - py
+            n = math.hypot(dx, dy)
+            a = 0.0
+            b = 0.0
+            if n > 1e-12:
+                a = dx / n * vcap
+                b = dy / n * vcap
+            a, b = _clip_holo(p0, p1, a, b, h, f)
+            px += a * h
+            py += b * h
+        elif behind:  # past the goal: brake rather than turn back
+            a, b = _clip_uni(p0, p1, 0.0, 0.0, h, f)
+            px, py, pth = unicycle_pose(px, py, pth, a, b, h)
+        else:
+            e = _wrap(math.atan2(cy - py, cx - px) - pth)
+            wd = abs(e) / h
+            if math.isfinite(alpha):
+                wd = min(wd, math.sqrt(2.0 * alpha * abs(e)))
+            wd = wd if e >= 0.0 else -wd
+            ce = math.cos(e)
+            vd = vcap * ce * ce if abs(e) < 0.5 * math.pi else 0.0
+            a, b = _clip_uni(p0, p1, vd, wd, h, f)
+            px, py, pth = unicycle_pose(px, py, pth, a, b, h)
+        seq[t, 0] = a
+        seq[t, 1] = b
+        p0 = a
+        p1 = b
+
+
+@njit(cache=True)
+def _brake(seq, f, c0, c1):
+    """Braking as hard as the limits allow, the yaw rate unwinding likewise."""
+    p0 = c0
+    p1 = c1
+    holo = f[M_HOLO] == 1.0
+    for t in range(seq.shape[0]):
+        h = f[M_DT] if t == 0 else f[M_MDT]
+        if holo:
+            a, b = _clip_holo(p0, p1, 0.0, 0.0, h, f)
+        else:
+            a, b = _clip_uni(p0, p1, 0.0, 0.0, h, f)
+        seq[t, 0] = a
+        seq[t, 1] = b
+        p0 = a
+        p1 = b
+
+
+@njit(cache=True)
+def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_mode, dpos,
+           dvel, drad):
+    """The cost of one control sequence (the critics, summed with their weights)."""
+    n = seq.shape[0]
+    holo = f[M_HOLO] == 1.0
+    radius = f[M_RADIUS]
+    margin = f[M_MARGIN]
+    infl_r = f[M_INFL_R]
+    infl_k = f[M_INFL_K]
+    segmax = f[M_SEGMAX]
+    std0 = f[M_STD0]
+    std1 = f[M_STD1]
+    gx = f[M_GX]
+    gy = f[M_GY]
+    nd = drad.shape[0]
+    px = x
+    py = y
+    pth = th
+    ca, ea = static_gap(field, f, x, y)
+    j = k0
+    cost = 0.0
+    obs = 0.0
+    align = 0.0
+    goal = 0.0
+    smooth = 0.0
+    back = 0.0
+    prox = 0.0
+    tc = -1
+    depth = 0.0
+    p0 = c0
+    p1 = c1
+    tt = 0.0
+    tnow = 0.0
+    hit = False
+    peak = 0.0
+    for t in range(n):
+        h = f[M_DT] if t == 0 else f[M_MDT]
+        a = seq[t, 0]
+        b = seq[t, 1]
+        d0 = (a - p0) / std0
+        d1 = (b - p1) / std1
+        smooth += d0 * d0 + d1 * d1
+        p0 = a
+        p1 = b
+        if holo:
+            nx = px + a * h
+            ny = py + b * h
+            nth = pth
+            dev = 0.0
+        else:
+            nx, ny, nth = unicycle_pose(px, py, pth, a, b, h)
+            dev = abs(a * b) * h * h / 8.0
+            if a < 0.0:
+                back += -a * h
+        cb, eb = static_gap(field, f, nx, ny)
+        c = min(ca, cb)
+        half = 0.5 * math.hypot(nx - px, ny - py)
+        seg = math.sqrt(c * c - half * half) if c > half else 0.0
+        # the distance to the map's outside is concave along a segment: its least at an end
+        if seg - dev < thr or min(ea, eb) - dev < thr:
+            # too close by the lower bounds: the chord's exact distance decides
+            d = segment_static_distance(occ, f[M_OX], f[M_OY], f[M_RES], px, py, nx, ny,
+                                        thr + dev + 1e-6)
+            if d - dev < thr:
+                # a collision with the static map: the earlier, the costlier; it ends here
+                cost += f[M_WCOLL] * (2.0 * n - t) / n
+                hit = True
+                break
+        j, d, tt = _track(nx, ny, pts, cum, j, k0, 2.0 * half + 2.0 * segmax, 2.0 * segmax)
+        gap = cb - radius  # the squares inflate, the map's edge does not (not an obstacle)
+        if gap < infl_r:
+            # beyond what the global path itself pays here (none where it has room)
+            e = math.exp(-infl_k * gap) - max(pexp[j], pexp[min(j + 1, pexp.shape[0] - 1)])
+            if e > 0.0:
+                obs += e
+                if e > peak:
+                    peak = e
+        if margin > 0.0 and gap < margin:
+            obs += MARGIN_COST * (margin - gap) / margin
+        for i in range(nd):
+            # the disc predicted at constant velocity; the least gap over the step, in
+            # closed form between the two linear motions (the arc's chord less its bound)
+            qx = dpos[i, 0] + dvel[i, 0] * tnow
+            qy = dpos[i, 1] + dvel[i, 1] * tnow
+            ex = px - qx
+            ey = py - qy
+            ddx = (nx - px) - dvel[i, 0] * h
+            ddy = (ny - py) - dvel[i, 1] * h
+            l2 = ddx * ddx + ddy * ddy
+            u = 0.0
+            if l2 > 0.0:
+                u = min(1.0, max(0.0, -(ex * ddx + ey * ddy) / l2))
+            g = math.hypot(ex + u * ddx, ey + u * ddy) - radius - drad[i] - dev
+            if g < 0.0:
+                if tc < 0:
+                    tc = t
+                depth = max(depth, min(-g / (radius + drad[i]), 1.0))
+            else:
+                prox += math.exp(-g / f[M_DDECAY])
+        align += d
+        if goal_mode:
+            goal += math.hypot(nx - gx, ny - gy)
+        px = nx
+        py = ny
+        pth = nth
+        ca = cb
+        ea = eb
+        tnow += h
+    m = pts.shape[0]
+    s_end = cum[j] + tt * (cum[min(j + 1, m - 1)] - cum[j])
+    cost += f[M_WPROG] * (cum[m - 1] - s_end)
+    cost += f[M_WOBS] * obs / n + f[M_PEAK] * peak + f[M_WSMOOTH] * smooth / n \
+        + f[M_WFWD] * back
+    if tc >= 0:
+        cost += f[M_WDCOLL] * (1.0 + depth + (n - tc) / n)
+    cost += f[M_WDPROX] * prox / n
+    if goal_mode:
+        cost += f[M_WGOAL] * goal / n
+    else:
+        cost += f[M_WALIGN] * align / n
+        if not holo:
+            cx, cy = _point_at(pts, cum, s_end + f[M_LOOK])
+            if math.hypot(cx - px, cy - py) > 1e-9:
+                cost += f[M_WHEAD] * abs(_wrap(math.atan2(cy - py, cx - px) - pth)) / math.pi
+    return cost, hit
+
+
+@njit(cache=True)
+def mppi_optimise(occ, field, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, pts, cum,
+                  pexp, k0, goal_mode, dpos, dvel, drad):
+    """One MPPI update from the pose ``(x, y, th)`` and the last command ``(c0, c1)``.
+
+    ``occ`` is the map's occupancy, ``field`` its clearance lower bound.
+    ``nominal`` (T, 2) is the previous optimal sequence shifted by the caller;
+    on return it holds the new one.  ``noise`` (K, T, 2) holds standard normal
+    draws (the first ``N_FIXED`` rows unused), ``ctrl`` (K, T, 2) and ``costs``
+    (K,) are work buffers (on return: the clipped samples and their softmax
+    weights, unnormalised).  ``k0`` is the robot's progress index on the path
+    ``pts`` (cumulative lengths ``cum``); ``goal_mode`` switches the goal critic
+    on; ``dpos``, ``dvel``, ``drad`` are the sensed discs.  Returns ``(a0, a1,
+    cost, collision_free_samples)``: the first control of the new sequence
+    (inside the window the world allows) and the cost of the new sequence.
+    """
+    nk = ctrl.shape[0]
+    n = ctrl.shape[1]
+    # the clearance a rollout must keep: the radius, or what a robot already closer has
+    radius = f[M_RADIUS]
+    here = segment_static_distance(occ, f[M_OX], f[M_OY], f[M_RES], x, y, x, y, radius)
+    thr = min(radius, here * (1.0 - 1e-9))
+    std0 = f[M_STD0]
+    std1 = f[M_STD1]
+    for t in range(n):
+        ctrl[0, t, 0] = nominal[t, 0]
+        ctrl[0, t, 1] = nominal[t, 1]
+    _clip_sequence(ctrl[0], f, c0, c1)
+    _guide(ctrl[1], f, field, x, y, th, c0, c1, pts, cum, k0, f[M_LOOK], 0.0)
+    # a regulated guide that slows near obstacles and keeps close to the path (it threads
+    # narrow passages)
+    _guide(ctrl[2], f, field, x, y, th, c0, c1, pts, cum, k0, 0.5 * f[M_LOOK], f[M_SLOW])
+    _brake(ctrl[3], f, c0, c1)
+    for k in range(N_FIXED, nk):
+        for t in range(n):
+            ctrl[k, t, 0] = nominal[t, 0] + std0 * noise[k, t, 0]
+            ctrl[k, t, 1] = nominal[t, 1] + std1 * noise[k, t, 1]
+        _clip_sequence(ctrl[k], f, c0, c1)
+    best = np.inf
+    free = 0
+    for k in range(nk):
+        c, hit = _score(ctrl[k], occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0,
+                        goal_mode, dpos, dvel, drad)
+        costs[k] = c
+        if c < best:
+            best = c
+        if not hit:
+            free += 1
+    guide = costs[1]
+    lam = f[M_TEMP]
+    total = 0.0
+    for k in range(nk):
+        wk = math.exp(-(costs[k] - best) / lam)
+        costs[k] = wk
+        total += wk
+    for t in range(n):
+        s0 = 0.0
+        s1 = 0.0
+        for k in range(nk):
+            s0 += costs[k] * ctrl[k, t, 0]
+            s1 += costs[k] * ctrl[k, t, 1]
+        nominal[t, 0] = s0 / total
+        nominal[t, 1] = s1 / total
+    # the mean of clipped sequences keeps their limits; rounding aside, clip once more
+    _clip_sequence(nominal, f, c0, c1)
+    # the guide instead when it scores better than the mean (ours: on an open path the
+    # noise's weighted mean is never exactly straight, the guide is)
+    mean, _ = _score(nominal, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0,
+                     goal_mode, dpos, dvel, drad)
+    if f[M_KEEP] == 1.0 and guide <= mean:
+        for t in range(n):
+            nominal[t, 0] = ctrl[1, t, 0]
+            nominal[t, 1] = ctrl[1, t, 1]
+        mean = guide
+    return nominal[0, 0], nominal[0, 1], mean, free

@@ -98,12 +98,17 @@ def test_no_stall_exit_runs_to_the_move_cap():
 def test_online_the_paper_step_drives_into_the_wall():
     from pathfuse import simulate
 
-    # (a disc robot: the world's collision test is an overlap, which a point never has)
+    # (a disc robot: the world's collision test is an overlap, which a point never has; the
+    # algorithm alone: the safety shield, which stops it in time, off)
     sc = {"map": {"rows": ["..........", ".....#....", ".........."]},
-          "start": [0.5, 1.5], "goal": [9.5, 1.5], "robot": {"radius": 0.2}}
+          "start": [0.5, 1.5], "goal": [9.5, 1.5], "robot": {"radius": 0.2, "shield": False}}
     ep = simulate(sc, planner={"name": "apf", "params": PAPER_VARIANT["apf"]})
     assert ep.status is Status.COLLISION and ep.collision_with == "static"
     assert simulate(sc, planner="apf").status is not Status.COLLISION
+    # with the shield the same commands never reach the wall
+    shielded = dict(sc, robot={"radius": 0.2})
+    ep = simulate(shielded, planner={"name": "apf", "params": PAPER_VARIANT["apf"]})
+    assert ep.status is not Status.COLLISION and ep.shield_counts["nearest"] > 0
 
 
 # ------------------------------------------------------------------ the reproduction

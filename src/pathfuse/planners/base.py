@@ -217,15 +217,16 @@ class Controller:
             u, w, code = shield_unicycle(
                 g.occupied, ox, oy, res, float(obs.position[0]), float(obs.position[1]),
                 float(obs.heading), float(cmd[0]), float(cmd[1]), float(a[0]), float(a[1]),
-                dt, rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2,
-                rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2, clear,
+                dt, float(rb.min_speed_mps), float(rb.max_speed_mps),
+                float(rb.max_accel_mps2), float(rb.max_yaw_rate_radps),
+                float(rb.max_yaw_accel_radps2), clear,
                 float(pb.robot_radius_m), dp, dv, dr, 0.0)
         else:
             u, w, code = shield_holonomic(
                 g.occupied, ox, oy, res, float(obs.position[0]), float(obs.position[1]),
                 float(cmd[0]), float(cmd[1]), float(a[0]), float(a[1]), dt,
                 float(self.max_speed if self.max_speed is not None else rb.max_speed_mps),
-                rb.max_accel_mps2, clear, float(pb.robot_radius_m), dp, dv, dr, 0.0)
+                float(rb.max_accel_mps2), clear, float(pb.robot_radius_m), dp, dv, dr, 0.0)
         self.shield_counts[code] += 1
         return np.array([u, w])
 

@@ -46,7 +46,7 @@ from pathfuse.problem import Problem
 from pathfuse.result import Status
 
 __all__ = ["Outcome", "Controller", "FieldController", "Observed", "CHUNK", "CAP_FACTOR",
-           "STALL_FRAC"]
+           "STALL_FRAC", "sensed_discs"]
 
 #: Moves per numba call between wall-clock checks when a time limit is set.
 CHUNK = 8192
@@ -61,6 +61,15 @@ _NO_DISCS = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0))
 def _plain(a: Any) -> np.ndarray:
     """A C-contiguous writable float64 array (one numba signature for every caller)."""
     return np.require(a, dtype=np.float64, requirements=("C", "W"))
+
+
+def sensed_discs(obs: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The sensed discs' positions, velocities and radii as the kernels take them (empty
+    arrays without discs)."""
+    sens = obs.obstacles
+    if not len(sens):
+        return _NO_DISCS
+    return _plain(sens.positions), _plain(sens.velocities), _plain(sens.radii)
 
 
 class Observed(Protocol):

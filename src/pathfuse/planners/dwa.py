@@ -77,7 +77,7 @@ import numpy as np
 
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
-from pathfuse.planners.base import Controller, Observed, Outcome
+from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
 from pathfuse.planners.dwa_kernel import dwa_choose, pack_dwa
 from pathfuse.planners.params import GlobalAStarParams
 from pathfuse.planners.registry import PlannerSpec, register
@@ -226,13 +226,7 @@ class DWAController(Controller):
     # ------------------------------------------------------------------ online
     def act(self, obs: Observed) -> np.ndarray:
         """``(v, omega)`` for a diff-drive robot, ``(vx, vy)`` for a holonomic one."""
-        sens = obs.obstacles
-        if len(sens):
-            dpos = np.require(sens.positions, np.float64, ("C", "W"))
-            dvel = np.require(sens.velocities, np.float64, ("C", "W"))
-            drad = np.require(sens.radii, np.float64, ("C", "W"))
-        else:
-            dpos, dvel, drad = _NO_DISCS
+        dpos, dvel, drad = sensed_discs(obs)
         self._sensed = (dpos, dvel, drad)
         cmd = obs.command
         a0, a1 = self._choose(float(obs.position[0]), float(obs.position[1]),

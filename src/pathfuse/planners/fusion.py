@@ -84,7 +84,7 @@ from pathfuse.field.kernels import (
 from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
 from pathfuse.grid import GridMap
-from pathfuse.planners.base import _NO_DISCS, FieldController, _plain
+from pathfuse.planners.base import FieldController, sensed_discs
 from pathfuse.planners.params import DiscParams, FieldParams, GlobalAStarParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -185,10 +185,7 @@ class FusionController(FieldController):
             return here
         keep = (self.buf, self.kbuf, self.state.copy(), self.buf[:n0].copy(),
                 self.kbuf[:n0].copy())
-        sens = obs.obstacles
-        discs = (_plain(sens.positions), _plain(sens.velocities), _plain(sens.radii)) \
-            if len(sens) else _NO_DISCS
-        self._call(self._window.steps, *discs)
+        self._call(self._window.steps, *sensed_discs(obs))
         line = np.concatenate([here, self.buf[n0 - 1:self.n]])
         self.buf, self.kbuf, self.state = keep[0], keep[1], keep[2]
         self.buf[:n0] = keep[3]

@@ -51,6 +51,7 @@ import numpy as np
 
 from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.planners.base import sensed_discs
 from pathfuse.planners.dwa_kernel import dwa_choose, dwa_progress, pack_dwa
 
 __all__ = ["ForceWindow", "PASSIVE_WINDOW"]
@@ -61,7 +62,6 @@ PASSIVE_WINDOW = False
 scenarios) the fusion reached 84/70/54/18 % with 0/2/4/8 discs without it and 84/70/38/14 %
 with it, never at fault either way (the shield still enforces passive safety)."""
 
-_NO_DISCS = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0))
 
 
 def _wrap(a: float) -> float:
@@ -161,13 +161,7 @@ class ForceWindow:
         robot's progress index ``k``."""
         x = float(obs.position[0])
         y = float(obs.position[1])
-        sens = obs.obstacles
-        if len(sens):
-            dpos = np.require(sens.positions, np.float64, ("C", "W"))
-            dvel = np.require(sens.velocities, np.float64, ("C", "W"))
-            drad = np.require(sens.radii, np.float64, ("C", "W"))
-        else:
-            dpos, dvel, drad = _NO_DISCS
+        dpos, dvel, drad = sensed_discs(obs)
         lc = polyline_cumlen(local)
         net = math.hypot(float(local[-1, 0]) - x, float(local[-1, 1]) - y)
         if self._stalled(x, y):

@@ -65,7 +65,7 @@ def machine_speedup(workers: int, n: int = 2_000_000, tasks: int = 8) -> float:
 def steady_rate(db: Path) -> float:
     with sqlite3.connect(db) as c:
         n, t0, t1 = c.execute("SELECT COUNT(*), MIN(started_at), MAX(finished_at) "
-                              "FROM runs").fetchone()
+                              "FROM pathfuse_runs").fetchone()
     span = (datetime.fromisoformat(t1) - datetime.fromisoformat(t0)).total_seconds()
     return n / span if span > 0 else float("nan")
 

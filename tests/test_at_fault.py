@@ -176,7 +176,7 @@ def _strip_new_values(db: Path) -> None:
     """Make a study database look written before these values existed."""
     keys = ", ".join(f"'$.{k}'" for k in ["collision_at_fault", *SHIELD_KEYS])
     with sqlite3.connect(db) as conn:
-        conn.execute(f"UPDATE runs SET metrics = json_remove(metrics, {keys})")
+        conn.execute(f"UPDATE pathfuse_runs SET metrics = json_remove(metrics, {keys})")
     conn.close()
 
 

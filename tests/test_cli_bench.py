@@ -77,7 +77,7 @@ def assert_one_line_error(proc, *fragments, code=2):
 def count(db: Path, where: str = "1") -> int:
     con = sqlite3.connect(db)
     try:
-        return con.execute(f"SELECT COUNT(*) FROM runs WHERE {where}").fetchone()[0]
+        return con.execute(f"SELECT COUNT(*) FROM pathfuse_results WHERE {where}").fetchone()[0]
     finally:
         con.close()
 
@@ -100,7 +100,8 @@ def test_bench_resume_and_report(tmp_path):
     assert "errors 0" in p.stdout and p.stderr == ""
     assert count(db) == 9 and count(db, "solved = 1") == 9
     con = sqlite3.connect(db)
-    keys = con.execute("SELECT id, run_key, solution_length FROM runs ORDER BY id").fetchall()
+    keys = con.execute("SELECT id, run_key, solution_length FROM pathfuse_results "
+                       "ORDER BY id").fetchall()
     con.close()
     # the same command again: nothing new runs, nothing changes
     again = run("bench", "tiny.yaml", "--db", db, "--workers", "1", "--no-progress",
@@ -111,7 +112,7 @@ def test_bench_resume_and_report(tmp_path):
         f"tiny: nothing to run, all 9 runs are already stored in {db} ('pathfuse report "
         f"{db}' summarises them)"]
     con = sqlite3.connect(db)
-    assert con.execute("SELECT id, run_key, solution_length FROM runs ORDER BY id") \
+    assert con.execute("SELECT id, run_key, solution_length FROM pathfuse_results ORDER BY id") \
         .fetchall() == keys
     assert con.execute("SELECT COUNT(*) FROM pathfuse_sessions").fetchone()[0] == 2
     con.close()

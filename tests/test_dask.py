@@ -150,7 +150,8 @@ def _stored(db, where="1"):
 
     try:
         with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=5) as c:
-            return int(c.execute(f"SELECT COUNT(*) FROM runs WHERE {where}").fetchone()[0])
+            return int(c.execute(f"SELECT COUNT(*) FROM pathfuse_results WHERE {where}")
+                       .fetchone()[0])
     except sqlite3.Error:
         return 0
 

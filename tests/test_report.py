@@ -149,8 +149,8 @@ def num(text: str) -> float:
 
 def groups(db: Path) -> list[tuple]:
     """(entry, config, kind) of every (map entry, planner config) with runs."""
-    return sql(db, "SELECT DISTINCT e.entry, c.name, r.kind FROM runs r "
-                   "JOIN experiments e ON e.id = r.experimentid "
+    return sql(db, "SELECT DISTINCT e.entry, c.name, r.kind FROM pathfuse_results r "
+                   "JOIN pathfuse_experiments e ON e.experimentid = r.experimentid "
                    "JOIN plannerConfigs c ON c.id = r.plannerid")
 
 
@@ -162,7 +162,8 @@ def runs_of(db: Path, entry: str | None, config: str, kind: str) -> list[sqlite3
     if entry is not None:
         where += " AND e.entry = ?"
         args.append(entry)
-    rows = con.execute("SELECT r.* FROM runs r JOIN experiments e ON e.id = r.experimentid "
+    rows = con.execute("SELECT r.* FROM pathfuse_results r "
+                       "JOIN pathfuse_experiments e ON e.experimentid = r.experimentid "
                        f"JOIN plannerConfigs c ON c.id = r.plannerid WHERE {where}",
                        args).fetchall()
     con.close()
@@ -217,7 +218,8 @@ def sql_pairs(db: Path, ref_config: str) -> dict[int, float]:
     """R_length of every run paired with ``ref_config`` on problem_key + seed, both solved."""
     rows = sql(db, """
         SELECT r.id, (r.solution_length - f.solution_length) / f.solution_length
-        FROM runs r JOIN runs f ON f.problem_key = r.problem_key AND f.seed = r.seed
+        FROM pathfuse_results r
+        JOIN pathfuse_results f ON f.problem_key = r.problem_key AND f.seed = r.seed
                                AND f.kind = r.kind
         JOIN plannerConfigs fc ON fc.id = f.plannerid
         WHERE fc.name = ? AND r.solved = 1 AND f.solved = 1""", (ref_config,))
@@ -228,7 +230,7 @@ def sql_pairs(db: Path, ref_config: str) -> dict[int, float]:
 def test_summary_matches_sql_per_entry_and_pooled(study):
     db, out, _ = study
     rows = read_csv(out / "summary.csv")
-    stored = dict(sql(db, "SELECT id, R_length FROM runs WHERE solved = 1 "
+    stored = dict(sql(db, "SELECT id, R_length FROM pathfuse_results WHERE solved = 1 "
                           "AND R_length IS NOT NULL"))
     seen = set()
     for entry, config, kind in groups(db):
@@ -237,13 +239,14 @@ def test_summary_matches_sql_per_entry_and_pooled(study):
         check_row(row, runs_of(db, entry, config, kind), stored)
         seen.add((entry, config))
     # pooled: one row per (kind, config) over every entry of the kind
-    for kind, config in sql(db, "SELECT DISTINCT r.kind, c.name FROM runs r "
+    for kind, config in sql(db, "SELECT DISTINCT r.kind, c.name FROM pathfuse_results r "
                                 "JOIN plannerConfigs c ON c.id = r.plannerid"):
         [row] = [r for r in rows if r["pooled"] == "True" and r["kind"] == kind
                  and r["config"] == config]
         assert row["scope"] == f"all {kind}"
         check_row(row, runs_of(db, None, config, kind), stored)
-    assert len(rows) == len(seen) + len(sql(db, "SELECT DISTINCT kind, plannerid FROM runs"))
+    assert len(rows) == len(seen) + len(sql(db, "SELECT DISTINCT kind, plannerid "
+                                                "FROM pathfuse_results"))
     # every run is counted exactly once per scope kind
     entry_total = sum(int(r["runs"]) for r in rows if r["pooled"] == "False")
     assert entry_total == sql(db, "SELECT COUNT(*) FROM runs")[0][0] == 50
@@ -258,8 +261,8 @@ def test_errors_and_failures_are_counted_not_dropped(study):
     assert row["failures"] == "ERROR:1; NO_PATH:1"
     assert num(row["success_rate"]) == pytest.approx(3 / 5)
     # the straight segment crosses obstacles on some maps: the report must say so
-    cf = sql(db, "SELECT SUM(collision_free), COUNT(*) FROM runs WHERE planner='straight' "
-                 "AND solved = 1")[0]
+    cf = sql(db, "SELECT SUM(collision_free), COUNT(*) FROM pathfuse_results "
+                 "WHERE planner='straight' AND solved = 1")[0]
     assert cf[0] < cf[1]
     pooled = [r for r in rows if r["pooled"] == "True" and r["config"] == "straight"][0]
     assert int(pooled["collision_free"]) == cf[0]
@@ -278,7 +281,7 @@ def test_default_r_length_is_the_stored_reference_and_equals_sql_pairing(study):
         assert default[k] == pytest.approx(v, rel=1e-12, abs=1e-15)
         assert vs_astar[k] == pytest.approx(v, rel=1e-12, abs=1e-15)
     # no dynamic run has a length reference by default
-    dyn = {r[0] for r in sql(db, "SELECT id FROM runs WHERE kind = 'dynamic'")}
+    dyn = {r[0] for r in sql(db, "SELECT id FROM pathfuse_results WHERE kind = 'dynamic'")}
     assert not dyn & set(default)
 
 
@@ -289,7 +292,7 @@ def test_reference_config_pairs_on_problem_and_seed(study, tmp_path):
     pairs = sql_pairs(db, ref)
     assert set(rep.r_length) == set(pairs)
     # static and dynamic runs pair within their kind (fusion ran in both)
-    kinds = dict(sql(db, "SELECT id, kind FROM runs"))
+    kinds = dict(sql(db, "SELECT id, kind FROM pathfuse_results"))
     assert {kinds[i] for i in pairs} == {"static", "dynamic"}
     files = rep.write(tmp_path / "o")
     rows = read_csv(files["summary_csv"])
@@ -331,7 +334,7 @@ def test_parameter_rows_pool_configs_by_value(study):
     rows = read_csv(out / "parameters.csv")
     assert {(r["kind"], r["planner"], r["parameter"]) for r in rows} == {
         ("static", "fusion", "r1_m"), ("dynamic", "fusion", "r1_m")}
-    stored = dict(sql(db, "SELECT id, R_length FROM runs WHERE solved = 1 "
+    stored = dict(sql(db, "SELECT id, R_length FROM pathfuse_results WHERE solved = 1 "
                           "AND R_length IS NOT NULL"))
     for r in rows:
         value = float(r["value"])
@@ -343,8 +346,9 @@ def test_parameter_rows_pool_configs_by_value(study):
             args.append(r["scope"])
         con = sqlite3.connect(db)
         con.row_factory = sqlite3.Row
-        runs = con.execute("SELECT r.* FROM runs r JOIN plannerConfigs c ON c.id = r.plannerid "
-                           f"JOIN experiments e ON e.id = r.experimentid WHERE {where}",
+        runs = con.execute("SELECT r.* FROM pathfuse_results r JOIN plannerConfigs c "
+                           "ON c.id = r.plannerid JOIN pathfuse_experiments e "
+                           f"ON e.experimentid = r.experimentid WHERE {where}",
                            args).fetchall()
         con.close()
         assert runs and int(r["configs"]) == 1
@@ -454,8 +458,9 @@ def test_config_names_and_parameter_columns(study):
     assert {r["param.r1_m"] for r in fus} == {"1", "2"}
     assert all(r["param.r1_m"] == "" for r in rows if r["planner"] != "fusion")
     # settings JSON is what the r1_m column reports
-    for cfg, settings in sql(db, "SELECT name, settings FROM plannerConfigs "
-                                 "WHERE planner = 'fusion'"):
+    for cfg, settings in sql(db, "SELECT name, settings FROM plannerConfigs c "
+                                 "JOIN pathfuse_configs p ON p.plannerid = c.id "
+                                 "WHERE p.planner = 'fusion'"):
         assert f"{json.loads(settings)['r1_m']:g}" in cfg
 
 
@@ -472,7 +477,7 @@ planners: [astar, thetastar, shortest]
     rep = build_report(db)
     con = sqlite3.connect(db)
     rows = con.execute(
-        "SELECT c.name, r.seed, r.solution_length FROM runs r JOIN plannerConfigs c "
+        "SELECT c.name, r.seed, r.solution_length FROM pathfuse_results r JOIN plannerConfigs c "
         "ON r.plannerid = c.id WHERE r.solved = 1").fetchall()
     low = {seed: length for name, seed, length in rows if name == "shortest"}
     by = {r["config"]: r for r in rep.rows if r["scope"] == "paper"}

@@ -215,7 +215,8 @@ def test_a_run_that_raises_is_stored_and_the_sweep_goes_on(tmp_path):
         good = st.results("status_name != 'ERROR'")
     assert {r["seed"] for r in bad} == {2} and all(r["config"] != "tdij" for r in bad)
     assert all(r["error"] == "RuntimeError: boom on seed 2" for r in bad)
-    assert all("Traceback" in r["traceback"] and r["status_text"] == "ERROR" for r in bad)
+    assert all("Traceback" in r["traceback"] and r["status_text"] == "Crash"  # OMPL's text
+               and r["status"] == 7 for r in bad)
     assert len(good) == s.total - s.errors
     # errors count as stored; retry_errors runs them again (and they fail again)
     assert run_bench(exp, db, workers=1, progress=False).ran == 0

@@ -1,7 +1,7 @@
 """Benchmark sweeps at scale: experiment files, a SQLite result store, parallel runs.
 
 * :mod:`pathfuse.bench.experiment` - the YAML experiment format and its run list;
-* :mod:`pathfuse.bench.store` - the OMPL-layout SQLite result store;
+* :mod:`pathfuse.bench.store` - the SQLite result store that OMPL's tools read;
 * :mod:`pathfuse.bench.runner` - :func:`run_bench` (local pool or Dask);
 * :mod:`pathfuse.bench.execute` - what a worker runs;
 * :mod:`pathfuse.bench.progress` - the progress bar.
@@ -26,8 +26,9 @@ Examples
 (0, 3)
 >>> with ResultStore(d / "study.db", readonly=True) as st:
 ...     rows = st.results()
->>> sorted({(r["config"], r["status_text"], r["R_length"]) for r in rows})  # A* is the reference
-[('astar', 'SUCCESS', 0.0)]
+>>> sorted({(r["config"], r["status_name"], r["status_text"], r["R_length"])
+...         for r in rows})        # pathfuse's status, OMPL's; A* is the reference
+[('astar', 'SUCCESS', 'Exact solution', 0.0)]
 >>> shutil.rmtree(d)
 """
 

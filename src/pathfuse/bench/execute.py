@@ -430,7 +430,9 @@ def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
     ``collisions`` 1 when the episode ended in a collision.  ``metrics`` holds the
     episode's scalar values, with ``collision_at_fault`` and the safety shield's
     counts (``shield_asked``, ``shield_nearest``, ``shield_emergency``,
-    ``shield_unsafe``, ``shield_evade``).
+    ``shield_unsafe``, ``shield_evade``).  ``progress`` holds the episode's samples of
+    time, distance to goal and clearance (:func:`episode_progress`) for OMPL's
+    ``progress`` table.
     """
     status = ep.status
     name = str(getattr(status, "name", status)).upper()
@@ -465,6 +467,9 @@ def episode_row(ep: Any, store_paths: bool = False) -> dict[str, Any]:
     row["metrics"] = json.dumps({**{k: v for k, v in _scalars(sc_d).items() if k not in timing},
                                  **_episode_extras(ep), **names}, sort_keys=True)
     row["timing"] = json.dumps(timing, sort_keys=True)
+    samples = episode_progress(ep)
+    if samples:
+        row["progress"] = samples
     if store_paths and positions.shape[0]:
         row["path"] = _path_blob(positions)
         headings = np.asarray(getattr(ep, "headings", ()), dtype=float).reshape(-1)
@@ -486,6 +491,55 @@ def _episode_extras(ep: Any) -> dict[str, Any]:
     for name, k in counts.items():
         out[f"shield_{name}"] = int(k)
     return out
+
+
+MAX_PROGRESS_SAMPLES = 100
+"""Progress samples of one episode at most (ticks evenly spread, the first and last always)."""
+
+
+def episode_progress(ep: Any) -> list[dict[str, float]]:
+    """The ``progress`` samples of an episode: ``time`` (simulated s), ``distance_to_goal``
+    (m, robot centre to goal) and ``clearance`` (m, robot disc to the nearest static cell,
+    capped at 2 m as in the episode, or moving disc; negative in a collision) at
+    :data:`MAX_PROGRESS_SAMPLES` ticks at most, spread evenly from the first to the last.
+
+    Empty for an episode without its scenario (older records)."""
+    sc = getattr(ep, "scenario", None)
+    pos = np.asarray(getattr(ep, "positions", np.zeros((0, 2))), dtype=float).reshape(-1, 2)
+    times = np.asarray(getattr(ep, "times", ()), dtype=float).reshape(-1)
+    n = min(pos.shape[0], times.shape[0])
+    if sc is None or n == 0:
+        return []
+    idx = np.unique(np.linspace(0, n - 1, min(n, MAX_PROGRESS_SAMPLES)).round().astype(int))
+    goal = np.asarray(sc.goal, dtype=float)
+    obst = np.asarray(getattr(ep, "obstacle_positions", np.zeros((n, 0, 2))), dtype=float)
+    radii = np.asarray(getattr(ep, "obstacle_radii", ()), dtype=float).reshape(-1)
+    out = []
+    for i in map(int, idx):
+        x, y = float(pos[i, 0]), float(pos[i, 1])
+        discs = obst[i] if radii.size and obst.ndim == 3 and i < obst.shape[0] else None
+        out.append({"time": float(times[i]),
+                     "distance_to_goal": float(math.hypot(goal[0] - x, goal[1] - y)),
+                     "clearance": _clearance_at(sc, x, y, discs, radii)})
+    return out
+
+
+def _clearance_at(sc: Any, x: float, y: float, discs: np.ndarray | None,
+                  radii: np.ndarray) -> float:
+    """Clearance of the robot disc at (x, y): to the static map (capped as the episode caps
+    it) and to the moving discs at ``discs`` (None: no disc)."""
+    from pathfuse.sweep import segment_static_distance
+    from pathfuse.world.world import STATIC_CLEARANCE_CAP_M
+
+    g = sc.grid
+    radius = float(sc.robot.radius)
+    gap = float(segment_static_distance(
+        g.occupied, float(g.origin[0]), float(g.origin[1]), float(g.resolution), x, y, x, y,
+        radius + STATIC_CLEARANCE_CAP_M)) - radius
+    if discs is not None:
+        gap = min(gap, float((np.hypot(discs[:, 0] - x, discs[:, 1] - y) - radii).min())
+                  - radius)
+    return gap
 
 
 KINDS: dict[str, Callable[[Mapping[str, Any], Mapping[str, Any], bool], dict[str, Any]]] = {

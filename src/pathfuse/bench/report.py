@@ -41,6 +41,11 @@ Statistics (every row):
   ``shortest``'s solved run on the same problem and seed (``excess_pairs``;
   :func:`~pathfuse.bench.study.excess_values`).
 
+Runs appended to the study from OMPL's benchmark logs (``ompl_benchmark_statistics -a``)
+are reported too: of kind ``ompl``, each OMPL experiment a scope ``"<name> [OMPL x.y.z]"``,
+their failures by OMPL's status text (an approximate solution is not solved, as in OMPL's
+``solved`` column).
+
 A swept parameter is one that takes more than one value among the
 configurations of a planner (per run kind), read from the configurations'
 full parameters (``plannerConfigs.settings``, the run's ``params`` without

@@ -1,85 +1,74 @@
-"""The result store: one SQLite database per study, in the layout of OMPL's benchmarks.
+"""The result store: one SQLite database per study, that OMPL's own tools read.
 
-The tables ``experiments``, ``plannerConfigs``, ``enums``, ``runs`` and
-``progress`` have the layout that OMPL's ``ompl_benchmark_statistics.py``
-writes (and Planner Arena reads): ``runs`` starts with ``id, experimentid,
-plannerid`` and holds one row per run with OMPL's property columns (spaces
-in OMPL's property names become underscores, as OMPL's log reader does),
-declared with OMPL's type words ``REAL``, ``INTEGER``, ``BOOLEAN``, ``ENUM``
-(an index into ``enums``).  pathfuse adds its own columns after them, and
-tables/views whose names start with ``pathfuse_``.
+OMPL's tables are written exactly as OMPL's ``ompl_benchmark_statistics``
+writes them, so Planner Arena loads a study and ``ompl_benchmark_statistics
+-a -d STUDY.db RUN.log`` appends OMPL's runs to it; everything else pathfuse
+keeps is in side tables whose names start with ``pathfuse_``, keyed by the
+run, experiment or configuration id (:mod:`pathfuse.bench.schema` declares
+the layout, :mod:`pathfuse.bench.migrate` upgrades a study of an older
+pathfuse).
 
 Mapping to OMPL's concepts: an OMPL *experiment* is one map entry of the
 study (``experiments.name = "<study>/<map entry>"``), a *planner config* is a
 planner with one parameter combination (``plannerConfigs.name`` like
-``fusion(r1=0.5,r2=2)``, ``settings`` = the full parameters as JSON), and a
-run is one (map, seed, query, planner config).
+``fusion(r1_m=0.5,r2_m=2,step_m=0.1)``, unique in the database;
+``settings`` = the full parameters as JSON), and a run is one (map, seed,
+query, planner config).
 
 Tables
 ------
-experiments
+experiments (OMPL)
     ``id``, ``name`` ("study/entry"), ``totaltime`` (s, sum of run wall times),
     ``timelimit`` (s per run, 0 if none), ``memorylimit`` (0), ``runcount``
     (runs per planner config), ``version`` ("pathfuse X.Y.Z"), ``hostname``,
-    ``cpuinfo``, ``date`` (first session), ``seed`` (first seed), ``setup``
-    (the map entry as JSON); pathfuse: ``study``, ``entry``, ``kind``.
-plannerConfigs
-    ``id``, ``name``, ``settings`` (canonical JSON of the full parameters);
-    pathfuse: ``planner`` (registry name).
-enums
-    ``name``, ``value``, ``description``: ``name = 'status'`` lists the run
-    statuses (pathfuse's :class:`~pathfuse.Status` names, then ``ERROR`` for a
-    run that raised or whose worker crashed).
-runs (OMPL columns)
-    ``id``; ``experimentid``; ``plannerid``; ``time`` (REAL, planning time in
-    s, ``PlanResult.time_s``, numba compilation excluded); ``solved``
-    (BOOLEAN); ``status`` (ENUM); ``memory`` (REAL, peak resident memory of
-    the worker process in MB); ``solution_length`` (REAL, m, NULL unless
-    solved); ``solution_clearance`` (REAL, m, smallest obstacle clearance);
-    ``solution_smoothness`` (REAL, as ``pathfuse.metrics`` defines it);
-    ``solution_segments`` (INTEGER, waypoints - 1).
-runs (pathfuse columns)
-    ``run_key`` (TEXT UNIQUE, SHA-256 of ``params``); ``problem_key`` (map +
-    query, to pair planners on the same problem); ``kind`` (static/dynamic);
-    ``map_name``; ``planner``; ``seed``; ``query_index``; ``scen_line``;
-    ``start_x``, ``start_y``, ``goal_x``, ``goal_y`` (m); ``status_name``;
-    ``expansions``; ``iterations``; ``steps``; ``collision_free`` (BOOLEAN);
-    ``collisions`` (INTEGER); ``time_to_goal`` (REAL, s, dynamic runs); ``path_length``
-    (REAL, m: the returned path's length, also when not solved; the driven trajectory's
-    for a dynamic run);
-    ``reference_length`` (m: the scen file's optimum, or the reference
-    planner's length on the same query); ``reference_source``; ``R_length``
-    (``(solution_length - reference_length) / reference_length``, the
-    paper's R_length against the reference); ``message``; ``error`` (one
-    line, runs that raised); ``traceback``; ``params`` (the run's full
-    parameters, canonical JSON); ``metrics`` (JSON of every scalar metric);
-    ``info`` (JSON of the planner's scalar extras); ``timing`` (JSON of
-    the extras that are clock readings: keys with time, rate, ``_s``);
-    ``path`` (BLOB,
-    little-endian float64 (N, 2), only with ``store_paths``); ``headings``
-    (BLOB, little-endian float64 (N,), the heading at each path point of a
-    dynamic run whose robot has one, only with ``store_paths``);
-    ``pathfuse_version``; ``host``; ``worker``; ``started_at``;
-    ``finished_at``; ``wall_time`` (s, whole run incl. metrics).
-progress
-    ``runid``, ``time`` (OMPL layout; more columns are added as a run kind
-    reports progress samples).
-pathfuse_meta
-    ``key``, ``value``: ``schema_version``, ``created_at``.
-pathfuse_sessions
-    One row per invocation: ``study``, ``experiment_file``,
-    ``experiment_sha256``, ``experiment_text``, ``started_at``,
-    ``finished_at``, ``state`` (running / finished / interrupted / failed),
-    ``host``, ``pathfuse_version``, ``python``, ``workers``, ``scheduler``,
-    ``planned``, ``skipped``, ``ran``, ``errors``.
+    ``cpuinfo``, ``date`` (first session), ``seed`` (first seed, text as in
+    OMPL), ``setup`` (the map entry as JSON).
+plannerConfigs (OMPL)
+    ``id``, ``name``, ``settings`` (canonical JSON of the full parameters).
+enums (OMPL)
+    ``name``, ``value``, ``description``: ``name = 'status'`` is OMPL's
+    ``PlannerStatus`` (0 Unknown status ... 4 Timeout, 5 Approximate solution,
+    6 Exact solution, 7 Crash, 8 Abort, 9 Infeasible problem).
+runs (OMPL)
+    ``id``, ``experimentid``, ``plannerid``, ``time`` (REAL, planning time in
+    s, numba compilation excluded), ``solved`` (BOOLEAN, an exact solution),
+    ``status`` (ENUM, OMPL's code: :data:`~pathfuse.bench.schema.STATUS_TO_OMPL`),
+    ``memory`` (REAL, peak resident memory of the worker in MB),
+    ``solution_length``, ``solution_clearance``, ``solution_smoothness``
+    (REAL), ``solution_segments`` (INTEGER); then pathfuse's numeric
+    properties, each added when a run first has a value, as OMPL's script adds
+    a column per property: ``expansions``, ``iterations``, ``steps``,
+    ``collision_free`` (BOOLEAN), ``collisions``, ``time_to_goal``,
+    ``path_length``, ``R_length``, ``wall_time``.
+progress (OMPL)
+    ``runid``, ``time``, then one REAL column per value a run samples: episodes
+    of the ``dynamic`` kind sample ``distance_to_goal`` and ``clearance`` (m)
+    against the simulated ``time`` (s).
+pathfuse_runs
+    One row per pathfuse run, ``runid`` = ``runs.id``: ``run_key``
+    (SHA-256 of ``params``), ``status_name`` (pathfuse's status), ``problem_key``,
+    ``kind``, ``map_name``, ``planner``, ``seed``, ``query_index``,
+    ``scen_line``, ``start_x``, ``start_y``, ``goal_x``, ``goal_y``, ``reference_length``,
+    ``reference_source``, ``message``, ``error``, ``traceback``, ``params``,
+    ``metrics``, ``info``, ``timing`` (JSON), ``pathfuse_version``, ``host``,
+    ``worker``, ``started_at``, ``finished_at``.
+pathfuse_paths
+    ``runid``, ``path`` (BLOB, little-endian float64 (N, 2)) and ``headings``
+    (BLOB, float64 (N,)), only with ``store_paths``.
+pathfuse_status
+    pathfuse's status vocabulary: ``name``, ``ompl_status``, ``description``.
+pathfuse_experiments, pathfuse_configs
+    ``study``, ``entry``, ``kind`` of each pathfuse experiment; ``planner``
+    (registry name) and ``label`` (the name pathfuse asked for) of each
+    pathfuse configuration.
+pathfuse_meta, pathfuse_sessions
+    ``schema_version`` and ``created_at``; one row per invocation.
 
-Views
------
-pathfuse_results
-    Every run with ``experiment`` (name), ``config`` (planner config name)
-    and ``status_text``: one flat table for reports.
-bestPlannerConfigsPerExperiment, bestPlannerConfigs
-    OMPL's summary views: mean ``solved`` and mean ``time`` per config.
+Runs appended from OMPL's logs have no ``pathfuse_runs`` row.  The view
+``pathfuse_results`` joins every run back to one flat row (with ``experiment``,
+``config`` and ``status_text``, OMPL's text of its status);
+``bestPlannerConfigs`` and ``bestPlannerConfigsPerExperiment`` are OMPL's
+summary views (OMPL's script replaces them with its own when it runs).
 
 Durability: WAL journal, one writer (the sweep's client process); each
 batch of finished runs is one transaction, so a run is either stored whole
@@ -95,9 +84,9 @@ Examples
 ...         n = st.insert_runs([{"run_key": "k1", "experimentid": e, "plannerid": p,
 ...                          "status_name": "SUCCESS", "solved": True, "time": 0.01,
 ...                          "solution_length": 14.14}])
-...         done, count = sorted(st.done_keys()), st.count()
->>> n, done, count
-(1, ['k1'], 1)
+...         row = st.results()[0]
+>>> n, row["run_key"], row["status"], row["status_text"]
+(1, 'k1', 6, 'Exact solution')
 """
 
 from __future__ import annotations
@@ -109,10 +98,26 @@ import socket
 import sqlite3
 from collections.abc import Iterable, Mapping, Sequence
 from datetime import datetime, timezone
-from pathlib import Path
 from typing import Any
 
-from pathfuse.result import ConfigError, PathfuseError, Status
+from pathfuse.bench.migrate import check_version, fill_status_tables, migrate, open_current
+from pathfuse.bench.schema import (
+    ATTRIBUTE_COLUMNS,
+    COLUMN_TABLE,
+    OMPL_RUN_COLUMNS,
+    OMPL_STATUS_TEXT,
+    PATH_COLUMNS,
+    RUN_COLUMNS,
+    SCHEMA_VERSION,
+    SIDE_COLUMNS,
+    STATUS_NAMES,
+    distinct_config_name,
+    ompl_status,
+    q,
+    schema_markdown,
+    schema_sql,
+)
+from pathfuse.result import ConfigError, PathfuseError
 
 __all__ = [
     "ResultStore",
@@ -124,130 +129,21 @@ __all__ = [
     "schema_markdown",
 ]
 
-SCHEMA_VERSION = 1
-
-STATUS_NAMES: tuple[str, ...] = tuple(s.name for s in Status) + ("ERROR",)
-"""Initial ``enums`` values of ``status`` (new names are appended, never renumbered)."""
-
-# (name, declared type, doc)
-RUN_COLUMNS: tuple[tuple[str, str, str], ...] = (
-    ("id", "INTEGER PRIMARY KEY AUTOINCREMENT", "OMPL: row id"),
-    ("experimentid", "INTEGER", "OMPL: experiments.id (the map entry)"),
-    ("plannerid", "INTEGER", "OMPL: plannerConfigs.id"),
-    ("time", "REAL", "OMPL: planning time in s (numba compilation excluded)"),
-    ("solved", "BOOLEAN", "OMPL: 1 when status is SUCCESS"),
-    ("status", "ENUM", "OMPL: index into enums(name='status')"),
-    ("memory", "REAL", "OMPL: peak resident memory of the worker in MB"),
-    ("solution_length", "REAL", "OMPL: path length in m (NULL unless solved)"),
-    ("solution_clearance", "REAL", "OMPL: smallest obstacle clearance of the path in m"),
-    ("solution_smoothness", "REAL", "OMPL: smoothness as pathfuse.metrics defines it"),
-    ("solution_segments", "INTEGER", "OMPL: number of path segments"),
-    ("run_key", "TEXT NOT NULL UNIQUE", "SHA-256 of params (the run's identity)"),
-    ("problem_key", "TEXT", "identity of map + query (pairs planners on a problem)"),
-    ("kind", "TEXT", "run kind: static or dynamic"),
-    ("map_name", "TEXT", "map entry name"),
-    ("planner", "TEXT", "planner registry name"),
-    ("seed", "INTEGER", "the run's seed"),
-    ("query_index", "INTEGER", "index of the query within the map entry and seed"),
-    ("scen_line", "INTEGER", "line of the MovingAI .scen file, if any"),
-    ("start_x", "REAL", "start x in m"),
-    ("start_y", "REAL", "start y in m"),
-    ("goal_x", "REAL", "goal x in m"),
-    ("goal_y", "REAL", "goal y in m"),
-    ("status_name", "TEXT", "status as text (Status name or ERROR)"),
-    ("expansions", "INTEGER", "grid search expansions"),
-    ("iterations", "INTEGER", "local planner steps / episode steps"),
-    ("steps", "INTEGER", "path steps as pathfuse.metrics counts them"),
-    ("collision_free", "BOOLEAN", "path collision-free for the robot radius"),
-    ("collisions", "INTEGER", "number of collisions (0 when collision-free)"),
-    ("time_to_goal", "REAL", "dynamic runs: simulated time to reach the goal in s"),
-    ("path_length", "REAL", "length in m of the returned path, also when not solved (a local "
-     "planner's partial path; the driven trajectory of a dynamic run)"),
-    ("reference_length", "REAL", "scen optimum or reference planner length in m"),
-    ("reference_source", "TEXT", "'scen' or the reference planner's name"),
-    ("R_length", "REAL", "(solution_length - reference_length) / reference_length"),
-    ("message", "TEXT", "the planner's message"),
-    ("error", "TEXT", "one-line error text of a run that raised"),
-    ("traceback", "TEXT", "traceback of a run that raised"),
-    ("params", "TEXT", "full run parameters, canonical JSON (hashed into run_key)"),
-    ("metrics", "TEXT", "JSON of every scalar metric"),
-    ("info", "TEXT", "JSON of the planner's scalar extras (clock readings excluded)"),
-    ("timing", "TEXT", "JSON of the planner's clock readings (keys naming a time/rate)"),
-    ("path", "BLOB", "little-endian float64 (N, 2) path, with store_paths"),
-    ("headings", "BLOB", "little-endian float64 (N,) heading in rad at each path point (dynamic "
-     "runs whose robot has a heading), with store_paths"),
-    ("pathfuse_version", "TEXT", "pathfuse version of the worker"),
-    ("host", "TEXT", "host name of the worker"),
-    ("worker", "TEXT", "worker process id or Dask worker address"),
-    ("started_at", "TEXT", "UTC start of the run (ISO 8601)"),
-    ("finished_at", "TEXT", "UTC end of the run (ISO 8601)"),
-    ("wall_time", "REAL", "wall-clock seconds of the whole run incl. metrics"),
-)
-
 WALL_CLOCK_COLUMNS: frozenset[str] = frozenset({
     "id", "time", "memory", "host", "worker", "started_at", "finished_at", "wall_time",
     "timing",
 })
 """Columns that differ between two otherwise identical sweeps (timing, placement)."""
 
-_RUN_COLS = [c for c, _, _ in RUN_COLUMNS]
-_INSERT_COLS = [c for c in _RUN_COLS if c != "id"]
-_INSERT_SET = frozenset(_INSERT_COLS)
-
-
-def _q(name: str) -> str:
-    return '"' + name.replace('"', '""') + '"'
-
-
-_INSERT_SQL = (
-    f"INSERT INTO runs ({', '.join(_q(c) for c in _INSERT_COLS)}) "
-    f"VALUES ({', '.join('?' for _ in _INSERT_COLS)}) ON CONFLICT(run_key) DO UPDATE SET "
-    + ", ".join(f"{_q(c)} = excluded.{_q(c)}" for c in _INSERT_COLS if c != "run_key")
-    + " WHERE runs.status_name = 'ERROR'")
-"""One run's insert: a new key is stored, a stored ERROR is replaced, anything else kept."""
-
-
-_SCHEMA = f"""
-CREATE TABLE IF NOT EXISTS experiments
-    (id INTEGER PRIMARY KEY AUTOINCREMENT, name VARCHAR(512), totaltime REAL,
-     timelimit REAL, memorylimit REAL, runcount INTEGER, version VARCHAR(128),
-     hostname VARCHAR(1024), cpuinfo TEXT, date DATETIME, seed INTEGER, setup TEXT,
-     study TEXT, entry TEXT, kind TEXT);
-CREATE TABLE IF NOT EXISTS plannerConfigs
-    (id INTEGER PRIMARY KEY AUTOINCREMENT, name VARCHAR(512) NOT NULL, settings TEXT,
-     planner TEXT);
-CREATE TABLE IF NOT EXISTS enums
-    (name VARCHAR(512), value INTEGER, description TEXT, PRIMARY KEY (name, value));
-CREATE TABLE IF NOT EXISTS runs
-    ({", ".join(f"{_q(c)} {t}" for c, t, _ in RUN_COLUMNS)},
-     FOREIGN KEY (experimentid) REFERENCES experiments(id) ON DELETE CASCADE,
-     FOREIGN KEY (plannerid) REFERENCES plannerConfigs(id) ON DELETE CASCADE);
-CREATE TABLE IF NOT EXISTS progress
-    (runid INTEGER, time REAL, PRIMARY KEY (runid, time),
-     FOREIGN KEY (runid) REFERENCES runs(id) ON DELETE CASCADE);
-CREATE TABLE IF NOT EXISTS pathfuse_meta (key TEXT PRIMARY KEY, value TEXT);
-CREATE TABLE IF NOT EXISTS pathfuse_sessions
-    (id INTEGER PRIMARY KEY AUTOINCREMENT, study TEXT, experiment_file TEXT,
-     experiment_sha256 TEXT, experiment_text TEXT, started_at TEXT, finished_at TEXT,
-     state TEXT, host TEXT, pathfuse_version TEXT, python TEXT, workers INTEGER,
-     scheduler TEXT, planned INTEGER, skipped INTEGER, ran INTEGER, errors INTEGER);
-CREATE INDEX IF NOT EXISTS runs_experiment_planner ON runs (experimentid, plannerid);
-CREATE INDEX IF NOT EXISTS runs_problem ON runs (problem_key, seed);
-CREATE VIEW IF NOT EXISTS pathfuse_results AS
-    SELECT runs.*, experiments.name AS experiment, plannerConfigs.name AS config,
-           enums.description AS status_text
-    FROM runs
-    JOIN experiments ON experiments.id = runs.experimentid
-    JOIN plannerConfigs ON plannerConfigs.id = runs.plannerid
-    LEFT JOIN enums ON enums.name = 'status' AND enums.value = runs.status;
-CREATE VIEW IF NOT EXISTS bestPlannerConfigsPerExperiment AS
-    SELECT plannerid, experimentid, AVG(solved) AS avg_solved, AVG(time) AS avg_total_time
-    FROM runs GROUP BY plannerid, experimentid
-    ORDER BY avg_solved DESC, avg_total_time ASC;
-CREATE VIEW IF NOT EXISTS bestPlannerConfigs AS
-    SELECT plannerid, AVG(solved) AS avg_solved, AVG(time) AS avg_total_time
-    FROM runs GROUP BY plannerid ORDER BY avg_solved DESC, avg_total_time ASC;
-"""
+_CORE = tuple(c for c, _, _ in OMPL_RUN_COLUMNS if c != "id")
+_ATTR_TYPES = {c: t for c, t, _ in ATTRIBUTE_COLUMNS}
+_SIDE = tuple(c for c, _, _ in SIDE_COLUMNS[1:])
+_PATHS = tuple(c for c, _, _ in PATH_COLUMNS[1:])
+_KNOWN = frozenset(COLUMN_TABLE) - {"id", "status"}
+_SIDE_SQL = (f"INSERT INTO pathfuse_runs (runid, {', '.join(map(q, _SIDE))}) "
+             f"VALUES (?{', ?' * len(_SIDE)})")
+_PATH_SQL = (f"INSERT INTO pathfuse_paths (runid, {', '.join(map(q, _PATHS))}) "
+             f"VALUES (?{', ?' * len(_PATHS)})")
 
 
 def _now() -> str:
@@ -255,14 +151,15 @@ def _now() -> str:
 
 
 class ResultStore:
-    """An open study database (created on first use).
+    """An open study database (created on first use, migrated when older).
 
     Parameters
     ----------
     path : path-like
         The SQLite file (``":memory:"`` for tests).
     readonly : bool
-        Open an existing database for reading only.
+        Open an existing database for reading only (a study of an older schema is
+        migrated in a copy in memory; the file is not written).
     check : bool
         Check the file first (:func:`~pathfuse.bench.dbcheck.check_study_file`); False
         when the caller just did.
@@ -271,9 +168,8 @@ class ResultStore:
     ------
     ConfigError
         The file is a folder, not SQLite, another application's database, damaged
-        (SQLite's ``quick_check``), read-only when opened for writing, or written by
-        a newer schema (:func:`~pathfuse.bench.dbcheck.check_study_file`; the
-        file is not touched before these checks).
+        (SQLite's ``quick_check``), read-only when opened for writing, or of a newer or
+        unknown schema (the file is not touched before these checks).
     """
 
     def __init__(self, path: str | os.PathLike[str], readonly: bool = False, *,
@@ -283,73 +179,51 @@ class ResultStore:
             from pathfuse.bench.dbcheck import check_study_file
 
             check_study_file(self.path, write=not readonly)  # only reads the file
-        if readonly:
-            uri = Path(self.path).resolve().as_uri() + "?mode=ro"
-            self.conn = sqlite3.connect(uri, uri=True, timeout=60.0)
-        else:
-            self.conn = sqlite3.connect(self.path, timeout=60.0, isolation_level=None)
+        try:
+            self.conn = open_current(self.path) if readonly else \
+                sqlite3.connect(self.path, timeout=60.0, isolation_level=None)
+        except sqlite3.DatabaseError as exc:
+            raise ConfigError(f"{self.path}: not a usable result database ({exc})") from None
         self.conn.row_factory = sqlite3.Row
         try:
-            self.conn.execute("PRAGMA foreign_keys = ON")
-            if not readonly:
-                self.conn.execute("PRAGMA journal_mode = WAL")
-                self.conn.execute("PRAGMA synchronous = NORMAL")
-                self._create()
-            self._status_values = self._load_enums()
+            self._open(readonly)
         except sqlite3.DatabaseError as exc:
             self.conn.close()
             raise ConfigError(f"{self.path}: not a usable result database ({exc})") from None
-
-    # ---------------------------------------------------------------- setup
-    def _create(self) -> None:
-        c = self.conn
-        c.execute("BEGIN IMMEDIATE")
-        try:
-            for stmt in _split_sql(_SCHEMA):
-                c.execute(stmt)
-            row = c.execute("SELECT value FROM pathfuse_meta WHERE key='schema_version'") \
-                .fetchone()
-            if row is None:
-                c.execute("INSERT INTO pathfuse_meta VALUES ('schema_version', ?)",
-                          (str(SCHEMA_VERSION),))
-                c.execute("INSERT INTO pathfuse_meta VALUES ('created_at', ?)", (_now(),))
-            elif int(row[0]) > SCHEMA_VERSION:
-                raise ConfigError(f"{self.path}: written by a newer pathfuse "
-                                  f"(schema {row[0]} > {SCHEMA_VERSION})")
-            have = {r[1] for r in c.execute("PRAGMA table_info(runs)")}
-            for name, typ, _ in RUN_COLUMNS:  # forward-compatible: add new columns
-                if name not in have:
-                    c.execute(f"ALTER TABLE runs ADD COLUMN {_q(name)} "
-                              f"{typ.replace('NOT NULL UNIQUE', '')}")
-            existing = {r[0] for r in c.execute(
-                "SELECT description FROM enums WHERE name='status'")}
-            nxt = c.execute("SELECT COALESCE(MAX(value) + 1, 0) FROM enums "
-                            "WHERE name='status'").fetchone()[0]
-            for s in STATUS_NAMES:
-                if s not in existing:
-                    c.execute("INSERT INTO enums VALUES ('status', ?, ?)", (nxt, s))
-                    nxt += 1
-            c.execute("COMMIT")
         except BaseException:
-            c.execute("ROLLBACK")
+            self.conn.close()
             raise
 
-    def _load_enums(self) -> dict[str, int]:
-        try:
-            rows = self.conn.execute(
-                "SELECT description, value FROM enums WHERE name='status'").fetchall()
-        except sqlite3.OperationalError as exc:
-            raise ConfigError(f"{self.path}: not a pathfuse/OMPL result database ({exc})") \
-                from None
-        return {r[0]: int(r[1]) for r in rows}
+    # ---------------------------------------------------------------- setup
+    def _open(self, readonly: bool) -> None:
+        self.conn.execute("PRAGMA foreign_keys = ON")
+        if not readonly:
+            migrate(self.conn, self.path)  # or refuse a newer schema, before any write
+            self.conn.execute("PRAGMA journal_mode = WAL")
+            self.conn.execute("PRAGMA synchronous = NORMAL")
+            self._create()
+        self._runs_cols = self._columns("runs")
+        if not self._runs_cols or not self._columns("pathfuse_runs"):
+            raise ConfigError(f"{self.path}: not a pathfuse study database (no table runs "
+                              "or pathfuse_runs)")
+        self._status_names = {r[0] for r in self.conn.execute("SELECT name FROM pathfuse_status")}
+        self._progress_cols = self._columns("progress")
+        self._sql: dict[tuple[str, ...], str] = {}
 
-    def _status_value(self, name: str) -> int:
-        if name not in self._status_values:
-            v = self.conn.execute("SELECT COALESCE(MAX(value) + 1, 0) FROM enums "
-                                  "WHERE name='status'").fetchone()[0]
-            self.conn.execute("INSERT INTO enums VALUES ('status', ?, ?)", (v, name))
-            self._status_values[name] = int(v)
-        return self._status_values[name]
+    def _create(self) -> None:
+        c = self.conn
+        with self.transaction():
+            for stmt in schema_sql():
+                c.execute(stmt)
+            if check_version(c, self.path) is None:
+                c.execute("INSERT OR REPLACE INTO pathfuse_meta VALUES ('schema_version', ?)",
+                          (str(SCHEMA_VERSION),))
+                c.execute("INSERT OR REPLACE INTO pathfuse_meta VALUES ('created_at', ?)",
+                          (_now(),))
+            fill_status_tables(c)
+
+    def _columns(self, table: str) -> set[str]:
+        return {r[1] for r in self.conn.execute(f"PRAGMA table_info({q(table)})")}
 
     # ---------------------------------------------------------------- context
     def close(self) -> None:
@@ -364,9 +238,14 @@ class ResultStore:
     # ---------------------------------------------------------------- registry rows
     def ensure_experiment(self, study: str, entry: str, kind: str, *, timelimit: float = 0.0,
                           runcount: int = 0, seed: int = 0, setup: str = "") -> int:
-        """The id of experiment ``study/entry``, inserting it on first use."""
+        """The id of pathfuse's experiment ``study/entry``, inserting it on first use.
+
+        An experiment of the same name appended from an OMPL log is another experiment.
+        """
         name = f"{study}/{entry}"
-        row = self.conn.execute("SELECT id FROM experiments WHERE name = ?", (name,)).fetchone()
+        row = self.conn.execute(
+            "SELECT e.id FROM experiments e JOIN pathfuse_experiments p "
+            "ON p.experimentid = e.id WHERE e.name = ?", (name,)).fetchone()
         if row is not None:
             self.conn.execute("UPDATE experiments SET runcount = ?, timelimit = ?, setup = ? "
                               "WHERE id = ?", (runcount, timelimit, setup, row[0]))
@@ -375,21 +254,37 @@ class ResultStore:
 
         cur = self.conn.execute(
             "INSERT INTO experiments (name, totaltime, timelimit, memorylimit, runcount, "
-            "version, hostname, cpuinfo, date, seed, setup, study, entry, kind) "
-            "VALUES (?, 0, ?, 0, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            "version, hostname, cpuinfo, date, seed, setup) "
+            "VALUES (?, 0, ?, 0, ?, ?, ?, ?, ?, ?, ?)",
             (name, timelimit, runcount, f"pathfuse {__version__}", socket.gethostname(),
-             _cpuinfo(), _now(), seed, setup, study, entry, kind))
-        return int(cur.lastrowid)  # type: ignore[arg-type]
+             _cpuinfo(), _now(), str(seed), setup))
+        eid = int(cur.lastrowid)  # type: ignore[arg-type]
+        self.conn.execute("INSERT INTO pathfuse_experiments VALUES (?, ?, ?, ?)",
+                          (eid, study, entry, kind))
+        return eid
 
     def ensure_planner_config(self, name: str, planner: str, settings: str) -> int:
-        """The id of planner config (``name``, ``settings``), inserting it on first use."""
-        row = self.conn.execute("SELECT id FROM plannerConfigs WHERE name = ? AND settings = ?",
-                                (name, settings)).fetchone()
+        """The id of planner config (``name``, ``settings``), inserting it on first use.
+
+        The stored ``plannerConfigs.name`` is ``name`` unless another configuration
+        has it already (:func:`~pathfuse.bench.schema.distinct_config_name`).
+        """
+        row = self.conn.execute(
+            "SELECT c.id FROM plannerConfigs c JOIN pathfuse_configs p ON p.plannerid = c.id "
+            "WHERE p.label = ? AND c.settings = ?", (name, settings)).fetchone()
         if row is not None:
             return int(row[0])
-        cur = self.conn.execute("INSERT INTO plannerConfigs (name, settings, planner) "
-                                "VALUES (?, ?, ?)", (name, settings, planner))
-        return int(cur.lastrowid)  # type: ignore[arg-type]
+        taken = {r[0] for r in self.conn.execute("SELECT name FROM plannerConfigs")}
+        rivals = [r[0] for r in self.conn.execute(
+            "SELECT c.settings FROM plannerConfigs c LEFT JOIN pathfuse_configs p "
+            "ON p.plannerid = c.id WHERE c.name = ? OR p.label = ? ORDER BY c.id",
+            (name, name))]
+        shown = distinct_config_name(name, settings, rivals, taken)
+        cur = self.conn.execute("INSERT INTO plannerConfigs (name, settings) VALUES (?, ?)",
+                                (shown, settings))
+        pid = int(cur.lastrowid)  # type: ignore[arg-type]
+        self.conn.execute("INSERT INTO pathfuse_configs VALUES (?, ?, ?)", (pid, planner, name))
+        return pid
 
     def transaction(self) -> _Tx:
         """``with store.transaction(): ...`` — one atomic write."""
@@ -398,61 +293,144 @@ class ResultStore:
     # ---------------------------------------------------------------- runs
     def done_keys(self, include_errors: bool = True) -> set[str]:
         """Run keys already stored (optionally not counting runs that raised)."""
-        sql = "SELECT run_key FROM runs"
+        sql = "SELECT run_key FROM pathfuse_runs"
         if not include_errors:
             sql += " WHERE status_name IS NOT 'ERROR'"
         return {r[0] for r in self.conn.execute(sql)}
 
     def count(self) -> int:
-        return int(self.conn.execute("SELECT COUNT(*) FROM runs").fetchone()[0])
+        """The number of pathfuse's runs (runs appended from OMPL logs not counted)."""
+        return int(self.conn.execute("SELECT COUNT(*) FROM pathfuse_runs").fetchone()[0])
 
     def insert_runs(self, rows: Sequence[Mapping[str, Any]]) -> int:
         """Store finished runs in one transaction; returns how many were new.
 
-        A row whose ``run_key`` is already stored replaces it only when the
-        stored run is an ``ERROR`` (a retried failure); otherwise it is
-        ignored (first result wins), so a run is never stored twice.
+        A row whose ``run_key`` is already stored replaces it (under the same
+        ``runs.id``) only when the stored run is an ``ERROR`` (a retried
+        failure); otherwise it is ignored (first result wins), so a run is never
+        stored twice.  ``status`` is derived from ``status_name`` and ``solved``;
+        a row's ``progress`` (a list of ``{"time": s, name: value}``) goes to the
+        ``progress`` table.
+
+        Raises
+        ------
+        PathfuseError
+            A row names a column the store does not know, or has no ``run_key``
+            (nothing of the batch is written).
         """
         if not rows:
             return 0
-        sql = _INSERT_SQL
-        new = 0
+        for row in rows:
+            unknown = row.keys() - _KNOWN - {"progress"}
+            if unknown:
+                raise PathfuseError(f"{self.path}: unknown result column(s): {sorted(unknown)}")
+            if not isinstance(row.get("run_key"), str) or not row["run_key"]:
+                raise PathfuseError(f"{self.path}: a result row without its run_key (run_key "
+                                    f"= {row.get('run_key')!r})")
         with self.transaction():
-            for row in rows:
-                values = dict(row)
-                values["status"] = self._status_value(str(values.get("status_name")
-                                                          or "ERROR"))
-                unknown = values.keys() - _INSERT_SET - {"progress"}
-                if unknown:
-                    raise PathfuseError(f"unknown result column(s): {sorted(unknown)}")
-                cur = self.conn.execute(sql, [_sqlval(values.get(c)) for c in _INSERT_COLS])
-                if cur.rowcount:
-                    new += 1
-                    if values.get("progress"):
-                        runid = self.conn.execute("SELECT id FROM runs WHERE run_key = ?",
-                                                  (values["run_key"],)).fetchone()[0]
-                        self._insert_progress(runid, values["progress"])
-        return new
+            self._add_attribute_columns(rows)
+            todo = self._new_rows(rows)
+            self._write(todo)
+        return len(todo)
+
+    def _new_rows(self, rows: Sequence[Mapping[str, Any]]
+                  ) -> list[tuple[int, Mapping[str, Any]]]:
+        """``(runs.id, row)`` of the rows to write: new keys get fresh ids, a retried
+        ERROR its old id (the old run is deleted with its side rows)."""
+        stored = self._stored([str(r["run_key"]) for r in rows])
+        nxt = int(self.conn.execute(
+            "SELECT MAX(COALESCE((SELECT MAX(id) FROM runs), 0), COALESCE((SELECT seq FROM "
+            "sqlite_sequence WHERE name = 'runs'), 0)) + 1").fetchone()[0])
+        todo: list[tuple[int, Mapping[str, Any]]] = []
+        for row in rows:
+            key = str(row["run_key"])
+            old = stored.get(key)
+            if old is not None and old[1] != "ERROR":
+                continue
+            if old is not None:
+                self.conn.execute("DELETE FROM runs WHERE id = ?", (old[0],))
+                rid = old[0]
+            else:
+                rid, nxt = nxt, nxt + 1
+            stored[key] = (rid, row.get("status_name"))
+            todo.append((rid, row))
+        return todo
+
+    def _stored(self, keys: Sequence[str]) -> dict[str, tuple[int, Any]]:
+        out: dict[str, tuple[int, Any]] = {}
+        for i in range(0, len(keys), 500):
+            chunk = keys[i:i + 500]
+            for r in self.conn.execute(
+                    "SELECT run_key, runid, status_name FROM pathfuse_runs WHERE run_key IN "
+                    f"({', '.join('?' for _ in chunk)})", chunk):
+                out[r[0]] = (int(r[1]), r[2])
+        return out
+
+    def _add_attribute_columns(self, rows: Sequence[Mapping[str, Any]]) -> None:
+        for name, typ in _ATTR_TYPES.items():
+            if name not in self._runs_cols and any(r.get(name) is not None for r in rows):
+                self.conn.execute(f"ALTER TABLE runs ADD COLUMN {q(name)} {typ}")
+                self._runs_cols.add(name)
+
+    def _write(self, todo: Sequence[tuple[int, Mapping[str, Any]]]) -> None:
+        """The ``runs``, ``pathfuse_runs``, ``pathfuse_paths`` and ``progress`` rows."""
+        by_cols: dict[tuple[str, ...], list[list[Any]]] = {}
+        for rid, row in todo:
+            name = row.get("status_name")
+            status = ompl_status(None if name is None else str(name), bool(row.get("solved")))
+            if name is not None and str(name) not in self._status_names:
+                self._new_status(str(name), status)
+            cols = _CORE + tuple(c for c in _ATTR_TYPES if row.get(c) is not None)
+            by_cols.setdefault(cols, []).append(
+                [rid, *(status if c == "status" else _sqlval(row.get(c)) for c in cols)])
+        for cols, values in by_cols.items():
+            self.conn.executemany(self._runs_sql(cols), values)
+        self.conn.executemany(_SIDE_SQL, [[rid, *(_sqlval(row.get(c)) for c in _SIDE)]
+                                          for rid, row in todo])
+        paths = [[rid, *(_sqlval(row.get(c)) for c in _PATHS)] for rid, row in todo
+                 if any(row.get(c) is not None for c in _PATHS)]
+        if paths:
+            self.conn.executemany(_PATH_SQL, paths)
+        for rid, row in todo:
+            if row.get("progress"):
+                self._insert_progress(rid, row["progress"])
+
+    def _runs_sql(self, cols: tuple[str, ...]) -> str:
+        sql = self._sql.get(cols)
+        if sql is None:
+            sql = self._sql[cols] = (f"INSERT INTO runs (id, {', '.join(map(q, cols))}) "
+                                     f"VALUES (?{', ?' * len(cols)})")
+        return sql
+
+    def _new_status(self, name: str, code: int) -> None:
+        """A status name that is not pathfuse's (a plug-in's) joins ``pathfuse_status``."""
+        self.conn.execute("INSERT OR IGNORE INTO pathfuse_status VALUES (?, ?, ?)",
+                          (name, code, OMPL_STATUS_TEXT[code]))
+        self._status_names.add(name)
 
     def _insert_progress(self, runid: int, samples: Iterable[Mapping[str, Any]]) -> None:
-        have = {r[1] for r in self.conn.execute("PRAGMA table_info(progress)")}
-        self.conn.execute("DELETE FROM progress WHERE runid = ?", (runid,))
+        by_cols: dict[tuple[str, ...], list[list[Any]]] = {}
         for s in samples:
-            for k in s:
-                if k not in have:
-                    self.conn.execute(f"ALTER TABLE progress ADD COLUMN {_q(k)} REAL")
-                    have.add(k)
-            cols = ["runid", *s.keys()]
-            self.conn.execute(
-                f"INSERT OR IGNORE INTO progress ({', '.join(map(_q, cols))}) "
-                f"VALUES ({', '.join('?' for _ in cols)})", [runid, *map(_sqlval, s.values())])
+            by_cols.setdefault(tuple(s), []).append([runid, *map(_sqlval, s.values())])
+        for cols, values in by_cols.items():
+            for k in cols:
+                if k not in self._progress_cols:
+                    self.conn.execute(f"ALTER TABLE progress ADD COLUMN {q(k)} REAL")
+                    self._progress_cols.add(k)
+            self.conn.executemany(
+                f"INSERT OR IGNORE INTO progress (runid, {', '.join(map(q, cols))}) "
+                f"VALUES (?{', ?' * len(cols)})", values)
 
     def update_totals(self) -> None:
-        """experiments.totaltime = sum of the wall times of its stored runs."""
+        """experiments.totaltime = sum of the wall times of its stored runs (pathfuse's
+        experiments only: an appended OMPL experiment keeps OMPL's total)."""
+        if "wall_time" not in self._runs_cols:
+            return
         with self.transaction():
             self.conn.execute(
                 "UPDATE experiments SET totaltime = COALESCE((SELECT SUM(wall_time) FROM runs "
-                "WHERE runs.experimentid = experiments.id), 0)")
+                "WHERE runs.experimentid = experiments.id), 0) "
+                "WHERE id IN (SELECT experimentid FROM pathfuse_experiments)")
 
     # ---------------------------------------------------------------- sessions
     def start_session(self, **fields: Any) -> int:
@@ -477,21 +455,28 @@ class ResultStore:
 
     # ---------------------------------------------------------------- reading
     def rows_by_key(self, keys: Sequence[str]) -> dict[str, dict[str, Any]]:
-        """The stored ``runs`` rows of the given run keys (missing keys are left out)."""
+        """The stored runs of the given run keys, as :meth:`results` gives them (missing
+        keys are left out)."""
         out: dict[str, dict[str, Any]] = {}
         keys = list(keys)
         for i in range(0, len(keys), 500):
             chunk = keys[i:i + 500]
             marks = ", ".join("?" for _ in chunk)
-            for r in self.conn.execute(f"SELECT * FROM runs WHERE run_key IN ({marks})", chunk):
-                out[r["run_key"]] = dict(r)
+            for r in self.results(f"run_key IN ({marks})", chunk):
+                out[r["run_key"]] = r
         return out
 
     def results(self, where: str = "", params: Sequence[Any] = ()) -> list[dict[str, Any]]:
-        """Rows of the ``pathfuse_results`` view (optionally filtered by SQL ``where``)."""
+        """Rows of the ``pathfuse_results`` view (optionally filtered by SQL ``where``).
+
+        Every column of :data:`RUN_COLUMNS` is a key (None where the run has no
+        value, e.g. a property no run has reported yet, or pathfuse's columns of
+        a run appended from an OMPL log).
+        """
         sql = "SELECT * FROM pathfuse_results" + (f" WHERE {where}" if where else "") + \
               " ORDER BY id"
-        return [dict(r) for r in self.conn.execute(sql, params)]
+        blank = dict.fromkeys(c for c, _, _ in RUN_COLUMNS)
+        return [{**blank, **dict(r)} for r in self.conn.execute(sql, params)]
 
 
 class _Tx:
@@ -504,10 +489,6 @@ class _Tx:
 
     def __exit__(self, exc_type: object, *rest: object) -> None:
         self.conn.execute("COMMIT" if exc_type is None else "ROLLBACK")
-
-
-def _split_sql(script: str) -> list[str]:
-    return [s.strip() for s in script.split(";") if s.strip()]
 
 
 _NATIVE = frozenset({str, bytes, int, bool, type(None)})
@@ -545,28 +526,23 @@ def _cpuinfo() -> str:
 
 def comparable_rows(path: str | os.PathLike[str],
                     exclude: Iterable[str] = WALL_CLOCK_COLUMNS) -> dict[str, dict[str, Any]]:
-    """``run_key -> row`` of a study, without wall-clock columns, ids resolved to names.
+    """``run_key -> row`` of a study's pathfuse runs: the columns of :data:`RUN_COLUMNS`
+    without wall-clock columns, ids resolved to names (``experiment_name``,
+    ``config_name``, ``config_settings``).
 
     Two sweeps of the same experiment give equal dicts whether or not they
     were interrupted, resumed, run in parallel or on a Dask cluster.
     """
-    excl = set(exclude)
+    excl = set(exclude) | {"experimentid", "plannerid"}
+    keep = [c for c, _, _ in RUN_COLUMNS if c not in excl]  # not the columns of OMPL's logs
     with ResultStore(path, readonly=True) as st:
-        rows = st.conn.execute(
-            "SELECT runs.*, experiments.name AS experiment_name, "
-            "plannerConfigs.name AS config_name, plannerConfigs.settings AS config_settings "
-            "FROM runs JOIN experiments ON experiments.id = runs.experimentid "
-            "JOIN plannerConfigs ON plannerConfigs.id = runs.plannerid").fetchall()
+        settings = {int(r[0]): r[1] for r in st.conn.execute(
+            "SELECT id, settings FROM plannerConfigs")}
+        rows = st.results("run_key IS NOT NULL")
     out: dict[str, dict[str, Any]] = {}
     for r in rows:
-        d = {k: r[k] for k in r.keys() if k not in excl
-             and k not in ("experimentid", "plannerid")}
+        d = {k: r[k] for k in keep}
+        d.update(experiment_name=r["experiment"], config_name=r["config"],
+                 config_settings=settings.get(r["plannerid"]))
         out[d["run_key"]] = d
     return out
-
-
-def schema_markdown() -> str:
-    """A Markdown table of the ``runs`` columns (for documentation)."""
-    lines = ["| column | type | meaning |", "|---|---|---|"]
-    lines += [f"| `{c}` | {t.split()[0]} | {doc} |" for c, t, doc in RUN_COLUMNS]
-    return "\n".join(lines)

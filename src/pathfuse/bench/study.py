@@ -76,28 +76,45 @@ class Study:
 # --------------------------------------------------------------------------- loading
 def _connect(path: Path) -> sqlite3.Connection:
     from pathfuse.bench.dbcheck import check_study_file
+    from pathfuse.bench.migrate import open_current
 
     check_study_file(path, write=False)  # a folder, not SQLite, foreign, damaged
     try:
-        conn = sqlite3.connect(path.resolve().as_uri() + "?mode=ro", uri=True, timeout=60.0)
+        conn = open_current(str(path))  # an older schema: migrated in memory, file untouched
         conn.row_factory = sqlite3.Row
         tables = {r[0] for r in conn.execute(
             "SELECT name FROM sqlite_master WHERE type IN ('table', 'view')")}
     except sqlite3.Error as exc:
         raise ConfigError(f"{path}: cannot read the database ({exc})") from None
-    need = {"runs", "experiments", "plannerConfigs", "pathfuse_meta"}
+    need = {"runs", "experiments", "plannerConfigs", "enums", "pathfuse_meta", "pathfuse_runs",
+            "pathfuse_experiments", "pathfuse_configs", "pathfuse_results"}
     if not need <= tables:
         conn.close()
         missing = ", ".join(sorted(need - tables))
         raise ConfigError(f"{path}: not a pathfuse study database (no table {missing}; "
                           "write one with pathfuse bench)")
-    cols = {r[1] for r in conn.execute("PRAGMA table_info(runs)")}
-    lacking = [c for c in _RUN_FIELDS if c not in cols]
-    if lacking:
-        conn.close()
-        raise ConfigError(f"{path}: not a pathfuse study database (runs has no column "
-                          f"{', '.join(lacking)})")
     return conn
+
+
+def _select_runs(conn: sqlite3.Connection) -> list[sqlite3.Row]:
+    """The columns of ``_RUN_FIELDS`` of every run (NULL for a property no run reported)."""
+    have = {r[1] for r in conn.execute("PRAGMA table_info(pathfuse_results)")}
+    cols = ", ".join(f'"{c}"' if c in have else f'NULL AS "{c}"' for c in _RUN_FIELDS)
+    return conn.execute(f"SELECT {cols}, run_key, status, status_text FROM pathfuse_results "
+                        "ORDER BY id").fetchall()
+
+
+def _run_dict(r: sqlite3.Row) -> dict[str, Any]:
+    """One run for the report.  A run appended from an OMPL log (no pathfuse row) is of
+    kind ``ompl``, its status OMPL's text, its planner its configuration."""
+    d = {c: r[c] for c in _RUN_FIELDS}
+    d["solved"] = bool(d["solved"])  # OMPL's solved: an exact solution, as pathfuse's
+    d["collision_free"] = _opt_bool(d["collision_free"])
+    if r["run_key"] is None:
+        d["kind"] = "ompl"
+        d["status_name"] = r["status_text"] or f"OMPL status {r['status']}"
+    d["kind"] = d["kind"] or "static"
+    return d
 
 
 def _json(text: Any) -> Any:
@@ -123,12 +140,13 @@ def load_study(db_path: str | Path) -> Study:
     path = Path(db_path)
     conn = _connect(path)
     try:
-        cols = ", ".join(f'runs."{c}"' for c in _RUN_FIELDS)
-        rows = conn.execute(f"SELECT {cols} FROM runs ORDER BY runs.id").fetchall()
-        exps = conn.execute("SELECT id, name, entry, kind FROM experiments ORDER BY id") \
-            .fetchall()
-        cfgs = conn.execute("SELECT id, name, planner, settings FROM plannerConfigs "
-                            "ORDER BY id").fetchall()
+        rows = _select_runs(conn)
+        exps = conn.execute("SELECT e.id, e.name, e.version, p.entry, p.kind "
+                            "FROM experiments e LEFT JOIN pathfuse_experiments p "
+                            "ON p.experimentid = e.id ORDER BY e.id").fetchall()
+        cfgs = conn.execute("SELECT c.id, c.name, p.planner, c.settings "
+                            "FROM plannerConfigs c LEFT JOIN pathfuse_configs p "
+                            "ON p.plannerid = c.id ORDER BY c.id").fetchall()
         try:
             sessions = [dict(r) for r in conn.execute(
                 "SELECT study, experiment_file, started_at, finished_at, state, host, "
@@ -144,19 +162,16 @@ def load_study(db_path: str | Path) -> Study:
         raise ConfigError(f"{path}: the study holds no runs yet "
                           "(run 'pathfuse bench EXPERIMENT.yaml --db "
                           f"{path}' first)")
-    runs = []
-    for r in rows:
-        d = dict(r)
-        d["solved"] = bool(d["solved"])
-        d["collision_free"] = _opt_bool(d["collision_free"])
-        d["kind"] = d["kind"] or "static"
-        runs.append(d)
+    runs = [_run_dict(r) for r in rows]
     experiments = {}
     for e in exps:
         name = e["name"] or f"experiment {e['id']}"
+        if e["kind"] is None:  # appended from an OMPL log: named apart from pathfuse's entries
+            experiments[int(e["id"])] = ExperimentInfo(int(e["id"]), name,
+                                                       f"{name} [{e['version']}]", "ompl")
+            continue
         entry = e["entry"] or name.rsplit("/", 1)[-1]
-        experiments[int(e["id"])] = ExperimentInfo(int(e["id"]), name, entry,
-                                                   e["kind"] or "static")
+        experiments[int(e["id"])] = ExperimentInfo(int(e["id"]), name, entry, e["kind"])
     kind_of: dict[int, str] = {}
     first_params: dict[int, Any] = {}
     for d in runs:

@@ -150,6 +150,21 @@ def test_robot_and_discs_are_drawn_where_the_episode_has_them(reached_ep):
         assert abs(x.mean() - dx) < tol and abs(y.mean() - dy) < tol
 
 
+def test_the_legend_names_every_marker_drawn_on_the_map_start_included(reached_ep):
+    r = anim._EpisodeRenderer(reached_ep, dpi=60, size_in=5.0, obstacle_trail_s=0.0,
+                              robot_trail=False, title=None)
+    (legend,) = r.fig.legends
+    entries = {t.get_text(): h for t, h in zip(legend.get_texts(), legend.legend_handles,
+                                                strict=True)}
+    assert {"start", "goal", "robot"} <= set(entries)
+    # the start's key looks like the start drawn on the map: a green dot with a black edge
+    start = entries["start"]
+    assert start.get_marker() == "o" and start.get_color() == "#2ca02c"
+    on_map = [ln for ln in r.ax.lines if ln.get_marker() == "o"
+              and tuple(ln.get_xydata()[0]) == tuple(reached_ep.scenario.start)]
+    assert on_map and on_map[0].get_color() == start.get_color()
+
+
 def test_collision_is_marked_only_on_the_last_frame(collision_ep):
     frames = list(render_frames(collision_ep, [0, collision_ep.n_ticks // 2,
                                                collision_ep.n_ticks], dpi=50))

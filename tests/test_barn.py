@@ -175,8 +175,11 @@ def test_cli_end_to_end_on_two_worlds(tmp_path):
         traj = np.array(r["trajectory"])
         assert traj.shape == (r["ticks"] + 1, 4)
     assert all(r["status"] == "success" for r in lines)
-    for name in ("barn.md", "summary.csv", "episodes.csv", "study.db"):
+    for name in ("barn.md", "summary.csv", "episodes.csv", "study.db", "barn_planners.png"):
         assert (out / name).is_file()
+    (world_png,) = out.glob("barn_world_*.png")  # one world's trajectories, a world run
+    assert world_png.name in ("barn_world_17.png", "barn_world_20.png")
+    assert f"wrote {world_png}" in p.stderr
     md = (out / "barn.md").read_text()
     assert "DWA (published)" in md and "not a like-for-like comparison" in md
     # the same command again resumes: nothing left to run, the same episodes
@@ -192,12 +195,117 @@ def test_cli_end_to_end_on_two_worlds(tmp_path):
     (["barn", BARN, "--worlds", "99"], "no world file for index 99"),
     (["barn", BARN, "--planners", "nope"], "unknown planner"),
     (["barn", BARN, "--resolution", "-1"], "--resolution"),
+    (["barn", BARN, "--worlds", "17", "--figure-world", "20"],
+     "--figure-world: world 20 is not among the worlds run (17)"),
+    (["barn", BARN, "--figure-world", "-1"], "--figure-world"),
 ])
 def test_cli_bad_input(tmp_path, args, fragment):
     p = _cli(*args, "--out", tmp_path / "o")
     assert p.returncode == 2
     assert fragment in p.stderr and "Traceback" not in p.stderr
     assert len(p.stderr.strip().splitlines()) == 1
+
+
+# --------------------------------------------------------------------- figures
+def _split(records, world):
+    st = [r["status"] for r in records if r["world"] == world]
+    ok = st.count("success")
+    return min(ok, len(st) - ok)
+
+
+def test_the_run_keeps_the_paths_of_the_world_its_figure_shows(barn_run):
+    from pathfuse.studies.barn import pick_figure_world
+
+    w = barn_run.figure_world
+    assert w == pick_figure_world(barn_run.records)
+    # no world splits the planners into successes and failures more evenly
+    assert _split(barn_run.records, w) == max(_split(barn_run.records, x.index)
+                                              for x in barn_run.worlds)
+    assert list(barn_run.paths) == list(barn_run.config.planners)
+    for r in barn_run.records:
+        if r["world"] == w:
+            assert np.array_equal(barn_run.paths[r["planner"]],
+                                  np.array(r["trajectory"])[:, 1:3])
+    cfg = BarnConfig(str(BARN), worlds="17,20", planners=("astar",))
+    assert run_barn(cfg, figure_world=20).figure_world == 20
+    none = run_barn(cfg, figure_world=None)
+    assert none.figure_world is None and none.paths == {}
+    with pytest.raises(ConfigError, match=r"figure_world: world 43 is not among the worlds "
+                                          r"run \(17, 20\)"):
+        run_barn(cfg, figure_world=43)
+
+
+def test_the_planner_figure_shows_each_planner_and_the_reference(barn_run):
+    from pathfuse.studies.barn import DWA_BASELINE
+    from pathfuse.viz.barn import OUTCOME_COLOURS, plot_barn_planners
+
+    rows = summary_rows(barn_run.records, barn_run.config.planners)
+    fig = plot_barn_planners(rows, baseline=DWA_BASELINE)
+    ax_o, ax_m = fig.axes[:2]
+    labels = [t.get_text() for t in ax_o.get_yticklabels()]
+    assert labels == [f"{r['planner']} (n=4)" for r in rows] + ["DWA (published): reference"]
+    ys = list(ax_o.get_yticks())
+    assert ys == sorted(ys, reverse=True)  # the first planner at the top
+    want = [(r["success_rate"], r["collision_rate"], r["timeout_rate"], r["metric_mean"])
+            for r in rows]
+    want.append(tuple(DWA_BASELINE[k] for k in ("success", "collision", "timeout", "metric")))
+    for y, (s, c, t, m) in zip(ys, want, strict=True):
+        bars = sorted((b for b in ax_o.patches if abs(b.get_y() + b.get_height() / 2 - y) < 1e-9),
+                      key=lambda b: b.get_x())
+        assert [b.get_width() for b in bars] == pytest.approx([100 * s, 100 * c, 100 * t])
+        assert [b.get_facecolor()[:3] for b in bars] == [
+            pytest.approx(matplotlib_rgb(OUTCOME_COLOURS[o]))
+            for o in ("success", "collision", "timeout")]
+        # the mean metric is drawn at its value on the row
+        assert any(np.allclose(ln.get_xydata(), [[m, y]]) for ln in ax_m.lines)
+
+
+def matplotlib_rgb(colour):
+    from matplotlib.colors import to_rgb
+
+    return to_rgb(colour)
+
+
+def test_the_world_figure_draws_each_trajectory_in_its_panel(barn_run, tmp_path):
+    from PIL import Image
+
+    from pathfuse.io.gazebo import read_gazebo_world
+    from pathfuse.studies.barn_report import write_barn_outputs
+    from pathfuse.viz.barn import plot_barn_world
+    from pathfuse.viz.dynamic import planner_colours
+
+    w = barn_run.figure_world
+    files = write_barn_outputs(barn_run, tmp_path)
+    assert files["planners_png"] == tmp_path / "barn_planners.png"
+    assert files["world_png"] == tmp_path / f"barn_world_{w}.png"
+    for key in ("planners_png", "world_png"):
+        assert Image.open(files[key]).format == "PNG"
+    md = files["report_md"].read_text(encoding="utf-8")
+    assert "](barn_planners.png)" in md and f"](barn_world_{w}.png)" in md
+    cfg = barn_run.config
+    recs = {r["planner"]: r for r in barn_run.records if r["world"] == w}
+    tracks = [{"planner": n, "status": recs[n]["status"], "time_s": recs[n]["time_s"],
+               "positions": barn_run.paths[n]} for n in cfg.planners]
+    (world,) = [x for x in barn_run.worlds if x.index == w]
+    grid = read_gazebo_world(world.world, cfg.resolution, bounds=BARN_BOUNDS)
+    fig = plot_barn_world(grid, tracks, start=BARN_START, goal=BARN_GOAL,
+                          goal_tolerance_m=1.0, robot_radius_m=cfg.robot_radius_m)
+    panels = [ax for ax in fig.axes if ax.get_visible()]
+    colours = planner_colours(list(cfg.planners))
+    assert len(panels) == len(tracks)
+    for ax, t in zip(panels, tracks, strict=True):
+        name, status = t["planner"], t["status"]
+        assert ax.get_title().split("\n")[0] == name and status in ax.get_title()
+        (own,) = [ln for ln in ax.lines
+                  if ln.get_color() == colours[name] and ln.get_linestyle() == "-"]
+        assert np.array_equal(own.get_xydata(), t["positions"])
+        crosses = [ln for ln in ax.lines if ln.get_marker() == "X"]
+        assert len(crosses) == (status == "collision")
+    fig.canvas.draw()  # the key under the panels, over none of them
+    r = fig.canvas.get_renderer()
+    (key,) = fig.legends
+    kb = key.get_window_extent(r)
+    assert all(kb.y1 <= ax.get_tightbbox(r).y0 for ax in panels)
 
 
 def test_online_subgoal_planners_do_not_jump_over_a_fine_subgoal(barn_run):

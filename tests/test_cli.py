@@ -147,3 +147,20 @@ def test_paper_variant_and_corner_cutting(tmp_path):
     md = (tmp_path / "q" / "tables.md").read_text()
     assert "Theta*" not in md and "Excess" not in md and "fusion/paper" not in md
 
+
+def test_paper_headline_says_how_many_ran_in_plain_words(tmp_path):
+    import re
+
+    out = tmp_path / "p"
+    args = ("paper", "--seeds", "2", "--variant", "pathfuse", "--no-references", "--workers",
+            "1", "--out", out, "--quiet")
+    p = run(*args)
+    assert p.returncode == 0, p.stderr
+    first = p.stdout.splitlines()[0]
+    assert re.fullmatch(r"(\d+) runs on 2 maps in \d+\.\d\d s \(\d+ runs/s, 1 worker"
+                        r"(, [\d.]+ s of it compiling kernels)?\)", first), first
+    n = int(first.split()[0])
+    again = run(*args).stdout.splitlines()[0]  # the same command: every run is stored
+    assert again == f"{n} runs on 2 maps, all already in {out / 'study.db'}"
+    assert "run now" not in p.stdout + again
+

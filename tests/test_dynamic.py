@@ -114,12 +114,37 @@ def test_summary_csv_agrees_with_an_independent_computation(files):
             assert float(row[f"{label}_mean_{unit}"]) == pytest.approx(m, rel=1e-12)
             assert float(row[f"{label}_median_{unit}"]) == pytest.approx(
                 statistics.median(vals), rel=1e-12)
-            if len(vals) > 1:
-                lo, hi = sps.t.interval(0.95, len(vals) - 1, loc=m, scale=sps.sem(vals))
-                assert float(row[f"{label}_ci_low_{unit}"]) == pytest.approx(lo, rel=1e-9)
-                assert float(row[f"{label}_ci_high_{unit}"]) == pytest.approx(hi, rel=1e-9)
+            lo, hi = float(row[f"{label}_ci_low_{unit}"]), float(row[f"{label}_ci_high_{unit}"])
+            if label == "time_to_goal":  # percentile bootstrap: within the data, around the mean
+                assert min(vals) <= lo <= m <= hi <= max(vals)
+            elif len(vals) > 1:
+                t_lo, t_hi = sps.t.interval(0.95, len(vals) - 1, loc=m, scale=sps.sem(vals))
+                assert lo == pytest.approx(t_lo, rel=1e-9)
+                assert hi == pytest.approx(t_hi, rel=1e-9)
         # episodes that did not reach the goal have no time to goal
         assert all((e["time_to_goal_s"] == "") == (e["status"] != "SUCCESS") for e in mine)
+
+
+def test_time_to_goal_interval_stays_within_the_data_as_the_report_says():
+    """A skewed sample (nine quick episodes, one slow): its Student-t interval would reach
+    below zero; the report's footnote promises an interval within the data."""
+    from pathfuse.studies.dynamic import DynamicRun, markdown_report
+
+    cfg = DynamicConfig(n_seeds=10, moving=(0,), planners=("fusion",))
+    times = [10.0] * 9 + [400.0]
+    recs = [{"moving": 0, "index": i, "planner": "fusion", "status": "SUCCESS",
+             "reached": True, "path_length_m": 14.0 + 0.1 * i, "time_to_goal_s": t,
+             "mean_plan_time_s": 1e-4, "collision_at_fault": None,
+             "min_static_clearance_m": 0.5, "min_obstacle_distance_m": math.inf}
+            for i, t in enumerate(times)]
+    t_lo = sps.t.interval(0.95, 9, loc=statistics.fmean(times), scale=sps.sem(times))[0]
+    assert t_lo < 0  # what the report used to print
+    (row,) = summary_rows(DynamicRun(cfg, recs, wall_s=1.0))
+    lo, hi = row["time_to_goal_ci_low_s"], row["time_to_goal_ci_high_s"]
+    assert min(times) <= lo < row["time_to_goal_mean_s"] == 49.0 < hi <= max(times)
+    md = markdown_report(DynamicRun(cfg, recs, wall_s=1.0))
+    assert f"| 49.00 [{lo:.2f}, {hi:.2f}] | 10.00 |" in md
+    assert "stays within the range of the data" in md
 
 
 def test_report_and_figure(files, run):

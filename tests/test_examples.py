@@ -8,7 +8,8 @@ import pytest
 
 import pathfuse
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples" / "scenarios"
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = ROOT / "examples" / "scenarios"
 
 
 @pytest.mark.parametrize("planner, params, status, t_s, hit", [
@@ -41,3 +42,38 @@ def test_head_on_astar_collides_and_fusion_passes():
     ep = pathfuse.simulate(str(path), planner="astar", robot={"radius": 0.2, "shield": False})
     assert ep.status.name == "COLLISION" and ep.collision_at_fault is True
     assert pathfuse.simulate(str(path), planner="fusion").status.name == "SUCCESS"
+
+
+def _as_commented(value: object, shown: str) -> str:
+    """``value`` as the README comment ``shown`` writes it (floats to its decimals)."""
+    if isinstance(value, float) and not isinstance(value, bool):
+        decimals = len(shown.split(".", 1)[1]) if "." in shown else 0
+        return f"{value:.{decimals}f}"
+    return str(value)
+
+
+def test_the_readme_moving_obstacles_example_prints_what_its_comments_say(monkeypatch):
+    """Each ``ep.<attr>, ...   # value, ...`` line of the README's first moving-obstacle
+    example is run; the values before a comment's first ':' are what it prints."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text[text.index("## Moving obstacles"):]
+    code = section[section.index("```python") + len("```python"):]
+    code = code[:code.index("```")]
+    monkeypatch.chdir(ROOT)  # the README's paths are those of a clone
+    env: dict[str, object] = {}
+    checked = 0
+    for line in code.splitlines():
+        stmt, _, comment = line.partition("#")
+        if not stmt.strip():
+            continue
+        if not stmt.startswith("ep.") or not comment.strip():
+            exec(stmt, env)  # noqa: S102 - the README's own example
+            continue
+        got = eval(stmt, env)  # noqa: S307
+        got = got if isinstance(got, tuple) else (got,)
+        want = [w.strip() for w in comment.split(":", 1)[0].split(",")]
+        assert len(want) == len(got), line
+        assert [_as_commented(g, w) for g, w in zip(got, want, strict=True)] == want, line
+        checked += 1
+    assert checked >= 2
+

@@ -288,6 +288,61 @@ def test_missing_file_and_yaml_line_number(tmp_path):
         parse_experiment("a: 1\nb: c: d\n", tmp_path / "x.yaml")
 
 
+def test_a_map_yaml_file_with_rows_runs_as_load_map_reads_it(tmp_path):
+    """``map: FILE.yaml`` names a ROS map or an inline-rows map, as ``load_map`` reads it."""
+    import numpy as np
+
+    from pathfuse.bench.runner import run_experiment
+    from pathfuse.bench.spec import load_map as load_spec
+    from pathfuse.bench.store import ResultStore
+    from pathfuse.io import load_map
+
+    rows = tmp_path / "maps" / "corridor.yaml"
+    rows.parent.mkdir()
+    rows.write_text('rows:\n  - "......"\n  - ".##..."\n  - "......"\nresolution: 0.5\n'
+                    "origin: [1, 2]\n")
+    text = ("seeds: 1\nmaps:\n  - map: maps/corridor.yaml\n    start: [1.25, 2.25]\n"
+            "    goal: [3.75, 3.25]\nplanners: [astar]\n")
+    exp = load_experiment(write(tmp_path, text))
+    (run,) = exp.expand()
+    assert run.group == "corridor"  # the entry is named after the file, as other map files
+    want, got = load_map(rows), load_spec(run.map_spec, exp.base_dir)
+    assert np.array_equal(got.occupied, want.occupied) and got.name == want.name == "corridor"
+    assert (got.resolution, tuple(got.origin)) == (want.resolution, tuple(want.origin))
+    store = ResultStore(":memory:")
+    try:
+        summary = run_experiment(exp, store, workers=1, progress=False)
+        stored = store.rows_by_key([run.key])[run.key]
+    finally:
+        store.close()
+    assert summary.ran == 1 and stored["status_name"] == "SUCCESS"
+    # the key follows the file's contents
+    rows.write_text(rows.read_text().replace(".##...", ".#...."))
+    assert load_experiment(tmp_path / "exp.yaml").expand()[0].key != run.key
+    # a ROS map YAML is still a ROS map
+    ros = REPO / "tests" / "data" / "ros" / "nav2_tb3_sandbox" / "tb3_sandbox.yaml"
+    exp = load_experiment(write(tmp_path, f"maps:\n  - map: {ros}\n    start: [-1.0, -0.5]\n"
+                                          "    goal: [1.5, 0.5]\nplanners: [xsweep]\n",
+                                "ros.yaml"))
+    assert exp.maps[0].family == "ros"
+
+
+@pytest.mark.parametrize("content, expected", [
+    ('rows:\n  - "..."\n  - ".."\n', "ragged rows"),
+    ('rows: ["..."]\ncolour: red\n', "unknown key 'colour'"),
+    ("size: 3\n", "needs an 'image' key (ROS map_server map) or a 'rows' key"),
+])
+def test_a_bad_map_yaml_file_is_one_line_naming_entry_and_file(tmp_path, content, expected):
+    (tmp_path / "m.yaml").write_text(content)
+    p = write(tmp_path, "maps:\n  - map: m.yaml\n    start: [0.5, 0.5]\n    goal: [2.5, 0.5]\n"
+                        "planners: [xsweep]\n")
+    with pytest.raises(ConfigError) as ei:
+        load_experiment(p)
+    msg = str(ei.value)
+    assert "\n" not in msg and msg.startswith(f"{p}: maps[0].map: ") and "m.yaml" in msg
+    assert expected in msg, msg
+
+
 def test_canonical_json_normalises_types():
     import numpy as np
 

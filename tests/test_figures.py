@@ -104,6 +104,19 @@ def test_animation_frames_are_legible_and_nothing_covers_the_clock(episode, tmp_
     assert not _overlap(clock, r.ax.get_window_extent(rend))  # above the map, not on it
 
 
+def _success_rows(planners, moving=(0, 2, 4, 8)):
+    from pathfuse.stats import wilson_ci
+
+    rows = []
+    for j, p in enumerate(planners):
+        for k in moving:
+            hits = max(0, 10 - j - k)
+            rate, lo, hi = wilson_ci(hits, 10)
+            rows.append({"planner": p, "moving": k, "reached_rate": rate,
+                         "reached_ci_low": lo, "reached_ci_high": hi})
+    return rows
+
+
 def test_the_success_plot_keeps_its_legend_off_the_points():
     from pathfuse.viz.dynamic import plot_success_vs_moving
 
@@ -115,7 +128,55 @@ def test_the_success_plot_keeps_its_legend_off_the_points():
     fig.canvas.draw()
     r = fig.canvas.get_renderer()
     leg = _legend(fig)
-    assert not _overlap(leg.get_window_extent(r), fig.axes[0].get_window_extent(r))
+    for ax in fig.axes:
+        assert not _overlap(leg.get_window_extent(r), ax.get_window_extent(r))
+
+
+def test_the_success_plot_has_one_panel_per_planner_on_shared_axes(tmp_path):
+    from pathfuse.viz.dynamic import planner_colours, plot_success_vs_moving
+
+    names = ["astar", "astar-replan", "apf", "fusion", "ref6", "ref7", "astar-smooth",
+             "thetastar", "lazy-thetastar", "shortest", "dwa", "mppi"]
+    rows = _success_rows(names)
+    out = tmp_path / "s.png"
+    fig = plot_success_vs_moving(rows, out, title="t")
+    assert Image.open(out).format == "PNG"
+    panels = [ax for ax in fig.axes if ax.get_visible()]
+    assert [ax.get_title() for ax in panels] == names
+    assert len({ax.get_ylim() for ax in panels}) == 1  # one scale for every panel
+    assert len({ax.get_xlim() for ax in panels}) == 1
+    colours = planner_colours(names)
+    assert len(set(colours.values())) == len(names)  # no two planners share a colour
+    for ax, name in zip(panels, names, strict=True):
+        own = [ln for ln in ax.lines if ln.get_color() == colours[name]]
+        assert len(own) == 1  # the panel's planner, once, in its colour ...
+        want = [100 * r["reached_rate"] for r in rows if r["planner"] == name]
+        assert np.allclose(own[0].get_ydata(), want)
+        others = [ln for ln in ax.lines if ln is not own[0]]
+        assert len(others) == len(names) - 1  # ... the others behind it, all one grey
+        assert len({ln.get_color() for ln in others}) == 1
+        assert others[0].get_color() not in colours.values()
+    # the panels do not overlap one another, nor their titles the panel above
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    boxes = [ax.get_tightbbox(r) for ax in panels]
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            assert not _overlap(a, b)
+
+
+def test_success_plot_with_one_disc_count_shows_the_interval_as_a_bar():
+    from pathfuse.viz.dynamic import plot_success_vs_moving
+
+    (row,) = _success_rows(["fusion"], moving=(3,))
+    assert 0 < row["reached_ci_low"] < row["reached_ci_high"] < 1
+    fig = plot_success_vs_moving([row])
+    (ax,) = [a for a in fig.axes if a.get_visible()]
+    spans = [seg[:, 1] for c in ax.collections for seg in c.get_segments()
+             if len(seg) == 2 and seg[0, 0] == seg[1, 0] == 3]
+    assert len(spans) == 1
+    assert sorted(spans[0]) == pytest.approx([100 * row["reached_ci_low"],
+                                              100 * row["reached_ci_high"]])
 
 
 def test_box_plots_explain_their_mean_marker(tmp_path, monkeypatch):
@@ -128,8 +189,7 @@ def test_box_plots_explain_their_mean_marker(tmp_path, monkeypatch):
         keys.append([t.get_text() for t in leg.get_texts()])
         return leg
 
-    monkeypatch.setattr(report, "boxplot_key", spy)
-    monkeypatch.setattr(paper, "boxplot_key", spy)
+    monkeypatch.setattr(report, "boxplot_key", spy)  # paper's R_length plot draws with it too
     report.plot_boxes(["a", "b"], [np.array([1.0, 2.0, 9.0]), np.array([2.0, 3.0])],
                       tmp_path / "b.png", xlabel="x", title="t")
     paper.plot_r_length({"astar": np.array([-0.1, -0.05, 0.01])}, 3, {"astar": "A*"},
@@ -137,3 +197,34 @@ def test_box_plots_explain_their_mean_marker(tmp_path, monkeypatch):
     assert len(keys) == 2
     for k in keys:
         assert "mean" in k and "line: median" in k and "box: middle 50 % (quartiles)" in k
+
+
+def test_the_r_length_box_plot_is_horizontal_with_readable_labels(tmp_path, monkeypatch):
+    from pathfuse.studies.paper_config import PAPER_LABELS
+    from pathfuse.viz import paper, report
+
+    shown = []
+    monkeypatch.setattr(report.plt, "close", shown.append)  # keep the figure to inspect it
+    rng = np.random.default_rng(0)
+    refs = ["astar", "apf", "ref6", "ref7", "astar-smooth", "thetastar", "shortest"]
+    r = {k: rng.normal(-0.05, 0.05, 30 - 17 * (k == "apf")) for k in refs}
+    out = tmp_path / "r.png"
+    paper.plot_r_length(r, 30, PAPER_LABELS, out)
+    assert Image.open(out).format == "PNG"
+    (fig,) = shown
+    ax = fig.axes[0]
+    # one row per reference, its label and sample size on the y axis, the first at the top
+    labels = [t.get_text() for t in ax.get_yticklabels()]
+    assert labels == [f"{PAPER_LABELS[k]} (n={r[k].size})" for k in refs]
+    assert list(ax.get_yticks()) == sorted(ax.get_yticks(), reverse=True)
+    assert ax.get_xlabel().startswith("R_length") and "%" in ax.get_xlabel()
+    assert any(ln.get_linestyle() == "--" and set(ln.get_xdata()) == {0.0} for ln in ax.lines)
+    fig.canvas.draw()
+    rend = fig.canvas.get_renderer()
+    boxes = [t.get_window_extent(rend) for t in ax.get_yticklabels()]
+    for i, a in enumerate(boxes):  # no label overlaps another, none leaves the figure
+        assert a.x0 >= 0
+        for b in boxes[i + 1:]:
+            assert not _overlap(a, b)
+    monkeypatch.undo()
+    report.plt.close(fig)

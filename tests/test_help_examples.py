@@ -53,11 +53,11 @@ def _examples(text: str) -> list[list[str]]:
     return out
 
 
+HELP = {"pathfuse": _help(), **{cmd: _help(cmd) for cmd in COMMANDS}}
+
+
 def _all_examples() -> list[tuple[str, list[str]]]:
-    found = [("pathfuse", ex) for ex in _examples(_help())]
-    for cmd in COMMANDS:
-        found += [(cmd, ex) for ex in _examples(_help(cmd))]
-    return found
+    return [(where, ex) for where, text in HELP.items() for ex in _examples(text)]
 
 
 EXAMPLES = _all_examples()
@@ -87,6 +87,23 @@ def _inputs(argv: list[str]) -> list[str]:
 def test_every_help_has_examples():
     assert {ex[0] for _, ex in EXAMPLES} >= set(COMMANDS)
     assert len(EXAMPLES) >= 25
+
+
+@pytest.mark.parametrize("where", sorted(HELP))
+def test_example_lines_have_no_runs_of_spaces(where):
+    """An example is printed as typed: its words one space apart (a ``\\``-newline that the
+    Python string swallowed once glued a continuation line's indent into the command)."""
+    lines = HELP[where].splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.rstrip() == "examples:")
+    seen = 0
+    for ln in lines[start + 1:]:
+        if ln and not ln.startswith(" "):
+            break  # the text after the examples
+        command = ln.split(" #", 1)[0].strip()  # aligned comments may keep their padding
+        if command:
+            seen += 1
+            assert "  " not in command, f"pathfuse {where} --help: {ln!r}"
+    assert seen
 
 
 @pytest.mark.parametrize("where, argv", EXAMPLES,

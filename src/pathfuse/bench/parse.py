@@ -39,6 +39,7 @@ from pathfuse.bench.spec import (
     _coerce_param,
     _file_of,
     _load_for_expand,
+    _yaml_map_spec,
     load_dynamic,
 )
 from pathfuse.limits import check_count
@@ -419,7 +420,8 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                           "{movingai: FILE}, {ros: FILE.yaml}; or use dynamic)")
     spec, family = _parse_map_spec(v["map"], f"{where}.map", exp_dir)
     default_name = family if family in GENERATED_FAMILIES else (
-        Path(_file_of(spec, family)).stem if family in FILE_FAMILIES else f"map-{i}")
+        Path(_file_of(spec, family)).stem if family in FILE_FAMILIES else
+        Path(v["map"]).stem if isinstance(v["map"], str) else f"map-{i}")
     name = _entry_name(v, where, default_name)
     given = [k for k in ("queries", "scen") if k in v] + (
         ["start/goal"] if ("start" in v or "goal" in v) else [])
@@ -533,7 +535,7 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
         elif low.endswith(".map"):
             m = {"movingai": m}
         elif low.endswith((".yaml", ".yml")):
-            m = {"ros": m}
+            m = _yaml_map_spec(m, where, exp_dir)
         else:
             raise ConfigError(f"{where}: {_shown(m)} is not a map family (paper, random) nor a "
                               ".map / .yaml file; use a mapping such as {image: FILE, "

@@ -422,6 +422,43 @@ def load_map(spec: Mapping[str, Any], base_dir: str | os.PathLike[str] = ".") ->
     return map_from_spec(dict(spec), base_dir)
 
 
+def _yaml_map_spec(rel: str, where: str, exp_dir: Path) -> dict[str, Any]:
+    """The map spec of a ``.yaml`` file named by its path, read as :func:`pathfuse.io.load_map`
+    reads it: a ROS map_server map (``{ros: FILE}``) when the file has ``image``, an
+    inline-rows map when it has ``rows`` (its ``rows``, ``resolution`` and ``origin``
+    inlined, named by its ``name`` or the file's stem, so the run key follows its
+    contents).  A missing file stays ``{ros: FILE}`` (the caller names it).
+
+    Raises
+    ------
+    ConfigError
+        A file that is not a YAML mapping, a rows map that does not read (ragged rows,
+        an unknown key, ...), or neither ``image`` nor ``rows``; the message names
+        ``where`` and the file.
+    """
+    from pathfuse.io.inline import read_rows_yaml
+    from pathfuse.io.ros import load_yaml_mapping
+
+    p = Path(os.path.expanduser(rel))
+    p = p if p.is_absolute() else exp_dir / p
+    if not p.is_file():
+        return {"ros": rel}
+    try:
+        doc = load_yaml_mapping(p, "map YAML")
+        if "image" in doc:
+            return {"ros": rel}
+        if "rows" not in doc:
+            raise ConfigError(f"{p}: a map YAML needs an 'image' key (ROS map_server map) or "
+                              f"a 'rows' key (inline map); found keys {sorted(map(str, doc))}")
+        read_rows_yaml(p)  # the checks load_map makes, naming the file
+    except PathfuseError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+    spec: dict[str, Any] = {"rows": doc["rows"],
+                            **{k: doc[k] for k in ("resolution", "origin") if k in doc}}
+    spec["name"] = doc["name"] if isinstance(doc.get("name"), str) else p.stem
+    return spec
+
+
 def load_dynamic(spec: Mapping[str, Any]) -> Any:
     """The :class:`~pathfuse.world.Scenario` of a loadable dynamic spec.
 

@@ -6,7 +6,7 @@ import argparse
 import sys
 from typing import Any
 
-from pathfuse.cli.args import _fmt, _Parser, _positive_float, _positive_int
+from pathfuse.cli.args import _fmt, _nonneg_int, _Parser, _positive_float, _positive_int
 
 __all__ = ["add_barn_parser", "cmd_barn"]
 
@@ -26,8 +26,10 @@ def add_barn_parser(sub: Any) -> None:
         "clip(time, 2 optimal_time, 8 optimal_time)).  Prints a table per planner (success, "
         "collision, timeout, mean metric, mean time, with 95% intervals) next to the "
         "challenge's published DWA baseline (measured in Gazebo: a reference line, not a "
-        "like-for-like comparison) and writes barn.md, summary.csv and episodes.csv into "
-        "--out; --out/study.db keeps every episode, so the same command resumes.",
+        "like-for-like comparison) and writes barn.md, summary.csv, episodes.csv, a figure "
+        "of the outcomes and mean metric by planner (barn_planners.png) and one of every "
+        "planner's trajectory on one world (barn_world_N.png) into --out; --out/study.db "
+        "keeps every episode, so the same command resumes.",
         epilog=_fmt("""
 examples:
   pathfuse barn tests/data/barn --worlds 0-20 --planners fusion,astar-replan
@@ -67,6 +69,9 @@ examples:
                    "same path; pip install 'pathfuse[dask]')")
     b.add_argument("--out", default="barn-out",
                    help="output folder (default barn-out); its study.db keeps every episode")
+    b.add_argument("--figure-world", type=_nonneg_int, default=None, metavar="N",
+                   help="the world whose trajectories barn_world_N.png shows (default: the "
+                   "one where the planners' outcomes differ most)")
     b.add_argument("--json", action="store_true",
                    help="print one JSON object per episode on stdout (world, planner, status, "
                    "time_s, metric, robot_radius_m, trajectory [[t, x, y, yaw], ...], ...) "
@@ -110,10 +115,20 @@ def cmd_barn(args: argparse.Namespace) -> int:
                      planners=planners,
                      resolution=base.resolution if args.resolution is None else args.resolution,
                      robot=robot, dt=base.dt if args.dt is None else args.dt, params=params)
+    if args.figure_world is not None:
+        from pathfuse.cli.args import CliError
+        from pathfuse.studies.barn import find_worlds
+
+        run_idx = [w.index for w in find_worlds(cfg.directory, cfg.worlds)]
+        if args.figure_world not in run_idx:
+            shown = ", ".join(map(str, run_idx[:10])) + (", ..." if len(run_idx) > 10 else "")
+            raise CliError(f"--figure-world: world {args.figure_world} is not among the worlds "
+                           f"run ({shown})")
     _warm_with_notice(list(cfg.planners), world=True)  # one notice for all of them
     run = run_barn(cfg, workers=args.workers, scheduler=args.scheduler,
                    db_path=_study_db(args.out), progress=False if args.quiet else None,
-                   trajectories=args.json)
+                   trajectories=args.json,
+                   figure_world="auto" if args.figure_world is None else args.figure_world)
     files = write_barn_outputs(run, args.out)
     if args.json:
         sys.stdout.write(json_lines(run.records))

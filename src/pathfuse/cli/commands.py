@@ -216,13 +216,7 @@ def cmd_paper(args: argparse.Namespace) -> int:
     run = run_paper(cfg, progress=False if args.quiet else None, workers=args.workers,
                     db_path=_study_db(args.out))
     files = write_paper_outputs(run, args.out)
-    n_runs = len(run.records)
-    sm = run.summary
-    print(f"{n_runs} runs on {cfg.n_seeds} maps: {sm.ran} run now in {run.wall_s:.2f} s "
-          f"({sm.runs_per_s:.0f} runs/s, {sm.workers} worker{'s' if sm.workers != 1 else ''}"
-          + (f", {sm.compile_s:.1f} s of it compiling kernels" if sm.compile_s >= 1.0 else "")
-          + ")"
-          + (f", {sm.skipped} already in {sm.db_path}" if sm.skipped else ""))
+    print(_paper_headline(len(run.records), cfg.n_seeds, run.wall_s, run.summary))
     print(f"{'variant':<9} {'planner':<13} {'success':>12} {'length mean':>12} {'R_length':>10} "
           f"{'excess':>9} {'time mean':>11}")
     for r in summary_rows(run):
@@ -235,6 +229,32 @@ def cmd_paper(args: argparse.Namespace) -> int:
     for path in files.values():
         print(f"wrote {path}")
     return 0
+
+
+def _paper_headline(n_runs: int, n_maps: int, wall_s: float, sm: Any) -> str:
+    """The first line ``pathfuse paper`` prints: how many runs, how many ran now and how fast.
+
+    ``sm`` is the run's :class:`~pathfuse.bench.runner.RunSummary` (``ran``, ``skipped``,
+    ``runs_per_s``, ``workers``, ``compile_s``, ``db_path``).
+
+    >>> from types import SimpleNamespace as S
+    >>> _paper_headline(1200, 100, 26.27, S(ran=1200, skipped=0, runs_per_s=45.7, workers=2,
+    ...                                     compile_s=0.0, db_path="p/study.db"))
+    '1200 runs on 100 maps in 26.27 s (46 runs/s, 2 workers)'
+    >>> _paper_headline(1200, 100, 0.5, S(ran=0, skipped=1200, runs_per_s=0.0, workers=1,
+    ...                                   compile_s=0.0, db_path="p/study.db"))
+    '1200 runs on 100 maps, all already in p/study.db'
+    """
+    what = f"{n_runs} run{'' if n_runs == 1 else 's'} on {n_maps} map{'' if n_maps == 1 else 's'}"
+    if sm.ran == 0 and sm.skipped:
+        return f"{what}, all already in {sm.db_path}"
+    how = (f"in {wall_s:.2f} s ({sm.runs_per_s:.0f} runs/s, {sm.workers} "
+           f"worker{'s' if sm.workers != 1 else ''}"
+           + (f", {sm.compile_s:.1f} s of it compiling kernels" if sm.compile_s >= 1.0 else "")
+           + ")")
+    if not sm.skipped:
+        return f"{what} {how}"
+    return f"{what}: {sm.ran} ran {how}, the other {sm.skipped} were already in {sm.db_path}"
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:

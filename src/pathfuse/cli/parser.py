@@ -51,13 +51,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="plan one path on a map and print (or plot) the result",
         description="Plan one path on a map.  Coordinates are world coordinates in metres "
         "(ROS convention: origin = lower-left corner of cell (0, 0)).",
-        epilog=_fmt("""
+        epilog=_fmt(r"""
 examples:
   pathfuse plan --map paper --seed 3 --planner astar --plot plan.png
   pathfuse plan --map tests/data/ros/nav2_tb3_sandbox/tb3_sandbox.yaml --start -1.0,-0.5 \
-                --goal 1.5,0.5 --robot-radius 0.1
+      --goal 1.5,0.5 --robot-radius 0.1
   pathfuse plan --map tests/data/ros/nav2_tb3_sandbox/tb3_sandbox.pgm --resolution 0.05 \
-                --start 9.0,9.5 --goal 11.5,10.5 --json
+      --start 9.0,9.5 --goal 11.5,10.5 --json
   pathfuse plan --map paper --planner astar --param heuristic=octile
 
 --map accepts: 'paper' (the paper's random 15 m map, --seed N), a MovingAI .map,
@@ -89,11 +89,11 @@ a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolu
         description="Run the lines of a MovingAI .scen file through A* (8-connected, sqrt(2) "
         "diagonals, no corner cutting) and count how many match the file's optimal length.  "
         "Exit status 1 on any mismatch.",
-        epilog=_fmt("""
+        epilog=_fmt(r"""
 examples:
   pathfuse scen tests/data/movingai/den312d.map tests/data/movingai/den312d.map.scen
   pathfuse scen tests/data/movingai/maze-32-32-2.map \
-                tests/data/movingai/maze-32-32-2-random-1.scen --limit 100 --heuristic euclidean
+      tests/data/movingai/maze-32-32-2-random-1.scen --limit 100 --heuristic euclidean
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

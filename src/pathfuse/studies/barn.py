@@ -62,7 +62,7 @@ __all__ = [
     "JACKAL_MAX_SPEED_M_S", "DWA_BASELINE", "BarnWorld", "BarnConfig", "BarnRun",
     "path_to_world", "reference_length", "barn_metric", "parse_world_selection",
     "find_worlds", "barn_experiment", "run_barn", "episode_record", "trajectory_with_yaw",
-    "load_barn_file", "BARN_FILE_KEYS", "default_robot", "jackal_robot",
+    "load_barn_file", "BARN_FILE_KEYS", "default_robot", "jackal_robot", "pick_figure_world",
 ]
 
 BARN_START = (-2.0, 3.0)
@@ -460,6 +460,13 @@ def trajectory_with_yaw(times: np.ndarray, positions: np.ndarray,
             zip(t, p[:, 0], p[:, 1], yaw, strict=True)]
 
 
+def _positions(row: Mapping[str, Any]) -> np.ndarray:
+    """The robot's (N, 2) positions per tick of a stored run (the start alone without any)."""
+    blob = row.get("path")
+    return np.frombuffer(blob, dtype="<f8").reshape(-1, 2) if blob else \
+        np.asarray([BARN_START], dtype=np.float64)
+
+
 def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: float,
                    robot_radius_m: float, optimal_time_s: float,
                    trajectory: bool = True) -> dict[str, Any]:
@@ -472,9 +479,7 @@ def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: f
     from pathfuse.world.episode import stored_at_fault, stored_shield_counts
 
     m = json.loads(row.get("metrics") or "{}")
-    blob = row.get("path")
-    pos = np.frombuffer(blob, dtype="<f8").reshape(-1, 2) if blob else \
-        np.asarray([BARN_START], dtype=np.float64)
+    pos = _positions(row)
     times = np.round(np.arange(pos.shape[0], dtype=np.float64) * dt, 9)
     status = str(row["status_name"])
     moved = np.hypot(pos[:, 0] - BARN_START[0], pos[:, 1] - BARN_START[1]) >= BARN_MOVE_START_M
@@ -513,23 +518,56 @@ def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: f
 
 @dataclass
 class BarnRun:
-    """Every episode of a BARN study (records in world, then planner order)."""
+    """Every episode of a BARN study (records in world, then planner order); ``paths``
+    holds the (N, 2) positions of every planner on the world ``figure_world``."""
 
     config: BarnConfig
     worlds: list[BarnWorld]
     records: list[dict[str, Any]]
     wall_s: float
     workers: int = 1
+    figure_world: int | None = None
+    paths: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def pick_figure_world(records: Sequence[Mapping[str, Any]]) -> int | None:
+    """The world whose trajectories tell most: where the planners' outcomes are most evenly
+    split between success and failure, then most varied, then lowest in total metric (the
+    hardest); the first such world in ``records``' order.  None without records.
+
+    >>> pick_figure_world([{"world": 3, "status": "success", "metric": 0.5},
+    ...                    {"world": 7, "status": "success", "metric": 0.2},
+    ...                    {"world": 7, "status": "timeout", "metric": 0.0}])
+    7
+    """
+    by: dict[int, list[Mapping[str, Any]]] = {}
+    for r in records:
+        by.setdefault(int(r["world"]), []).append(r)
+
+    def score(rs: list[Mapping[str, Any]]) -> tuple[int, int, float]:
+        ok = sum(r["status"] == "success" for r in rs)
+        return (min(ok, len(rs) - ok), len({r["status"] for r in rs}),
+                -sum(float(r["metric"]) for r in rs))
+
+    return max(by, key=lambda w: score(by[w]), default=None)
 
 
 def run_barn(config: BarnConfig, *, workers: int | None = 1, scheduler: Any = None,
              db_path: str | os.PathLike[str] | None = None, progress: bool | None = False,
-             trajectories: bool = True, stream: Any = None) -> BarnRun:
-    """Run (or resume, with ``db_path``) the BARN protocol with the study engine."""
+             trajectories: bool = True, stream: Any = None,
+             figure_world: int | str | None = "auto") -> BarnRun:
+    """Run (or resume, with ``db_path``) the BARN protocol with the study engine.
+
+    ``figure_world`` is the world whose paths the run keeps for its figure (``"auto"``:
+    :func:`pick_figure_world`; None: none); a world not run is a :class:`ConfigError`.
+    """
     from pathfuse.bench.runner import run_experiment
     from pathfuse.bench.store import ResultStore
 
     worlds = find_worlds(config.directory, config.worlds)
+    if figure_world not in (None, "auto") and figure_world not in {w.index for w in worlds}:
+        raise ConfigError(f"figure_world: world {figure_world!r} is not among the worlds run "
+                          f"({_ranges([w.index for w in worlds])})")
     optimal = {w.index: w.reference_length_m() / REFERENCE_SPEED_M_S for w in worlds}
     exp = barn_experiment(config, worlds)
     specs = exp.expand()
@@ -547,4 +585,8 @@ def run_barn(config: BarnConfig, *, workers: int | None = 1, scheduler: Any = No
     records = [episode_record(by_name[r.group], r.planner, stored[r.key], config.dt,
                               config.robot_radius_m, optimal[by_name[r.group].index],
                               trajectories) for r in ordered]
-    return BarnRun(config, worlds, records, summary.wall_s, summary.workers)
+    shown = pick_figure_world(records) if figure_world == "auto" else figure_world
+    paths = {r.planner: _positions(stored[r.key]) for r in ordered
+             if by_name[r.group].index == shown}
+    return BarnRun(config, worlds, records, summary.wall_s, summary.workers,
+                   None if shown is None else int(shown), paths)

@@ -207,8 +207,10 @@ def _table(rows: Sequence[Mapping[str, Any]], baseline: Mapping[str, Any] | None
     return table
 
 
-def markdown_report(run: Any, rows: Sequence[Mapping[str, Any]] | None = None) -> str:
-    """The study as Markdown: the setup, the table with the DWA reference line, notes."""
+def markdown_report(run: Any, rows: Sequence[Mapping[str, Any]] | None = None,
+                    figures: Mapping[str, str] | None = None) -> str:
+    """The study as Markdown: the setup, the table with the DWA reference line, notes, and
+    ``figures`` (caption -> image file, relative to the report) below them."""
     from pathfuse.studies.barn import (
         BARN_GOAL,
         BARN_GOAL_TOLERANCE_M,
@@ -250,6 +252,7 @@ def markdown_report(run: Any, rows: Sequence[Mapping[str, Any]] | None = None) -
         "robot with exact continuous collision checks against the occupied cells, perfect "
         "localisation and the map known in advance, so its rates are not those a Gazebo "
         "run would give.\n"
+        + "".join(f"\n![{cap}]({f})\n\n*{cap}*\n" for cap, f in (figures or {}).items())
     )
 
 
@@ -272,19 +275,64 @@ def text_table(rows: Sequence[Mapping[str, Any]]) -> str:
 
 
 def write_barn_outputs(run: Any, out_dir: str | Path) -> dict[str, Path]:
-    """Write ``barn.md``, ``summary.csv`` and ``episodes.csv`` (no trajectories) into
+    """Write ``barn.md``, ``summary.csv``, ``episodes.csv`` (no trajectories), the figure of
+    the planners (``barn_planners.png``: :func:`~pathfuse.viz.barn.plot_barn_planners`)
+    and, when the run kept one world's paths (``run.figure_world``), that world's
+    trajectories (``barn_world_N.png``: :func:`~pathfuse.viz.barn.plot_barn_world`) into
     ``out_dir``; return their paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     rows = summary_rows(run.records, run.config.planners)
     files = {"report_md": out / "barn.md", "summary_csv": out / "summary.csv",
              "episodes_csv": out / "episodes.csv"}
-    files["report_md"].write_text(markdown_report(run, rows), encoding="utf-8")
+    figures = _write_figures(run, rows, out)
+    files["report_md"].write_text(markdown_report(
+        run, rows, {cap: f.name for cap, f in figures.values()}), encoding="utf-8")
     write_csv(files["summary_csv"], [{k: ("" if isinstance(v, float) and math.isnan(v) else v)
                                       for k, v in r.items()} for r in rows])
     write_csv(files["episodes_csv"], [{k: ("" if v is None else v) for k, v in r.items()
                                        if k != "trajectory"} for r in run.records])
+    files.update({k: f for k, (_, f) in figures.items()})
     return files
+
+
+def _write_figures(run: Any, rows: Sequence[Mapping[str, Any]], out: Path
+                   ) -> dict[str, tuple[str, Path]]:
+    """The figures of :func:`write_barn_outputs`: ``{key: (caption, file)}``."""
+    from pathfuse.studies.barn import (
+        BARN_BOUNDS,
+        BARN_GOAL,
+        BARN_GOAL_TOLERANCE_M,
+        BARN_START,
+        DWA_BASELINE,
+    )
+    from pathfuse.viz.barn import plot_barn_planners, plot_barn_world
+
+    cfg = run.config
+    n_worlds = len(run.worlds)
+    figs: dict[str, tuple[str, Path]] = {}
+    cap = (f"Outcomes and mean metric by planner over {n_worlds} world"
+           f"{'s' if n_worlds != 1 else ''}")
+    figs["planners_png"] = (cap, out / "barn_planners.png")
+    plot_barn_planners(rows, figs["planners_png"][1], baseline=DWA_BASELINE, title=cap)
+    w = next((w for w in run.worlds if w.index == getattr(run, "figure_world", None)), None)
+    if w is None:
+        return figs
+    from pathfuse.io.gazebo import read_gazebo_world
+
+    recs = {r["planner"]: r for r in run.records if r["world"] == w.index}
+    tracks = [{"planner": name, "status": recs[name]["status"], "time_s": recs[name]["time_s"],
+               "positions": run.paths[name]} for name in cfg.planners
+              if name in recs and name in run.paths]
+    if not tracks:
+        return figs
+    cap = f"The trajectories on world {w.index}, one panel per planner"
+    figs["world_png"] = (cap, out / f"barn_world_{w.index}.png")
+    grid = read_gazebo_world(w.world, cfg.resolution, bounds=BARN_BOUNDS)
+    plot_barn_world(grid, tracks, figs["world_png"][1], start=BARN_START, goal=BARN_GOAL,
+                    goal_tolerance_m=BARN_GOAL_TOLERANCE_M,
+                    robot_radius_m=cfg.robot_radius_m, title=cap)
+    return figs
 
 
 def json_lines(records: Sequence[Mapping[str, Any]]) -> str:

@@ -372,9 +372,9 @@ def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
                 row.update({f"{key}_rate": g[f"{low}_rate"], f"{key}_ci_low": g[f"{low}_ci_low"],
                             f"{key}_ci_high": g[f"{low}_ci_high"]})
             ok = [r for r in recs if r["status"] == "SUCCESS"]
-            for col, label, unit in (("path_length_m", "path_length", "_m"),
-                                     ("time_to_goal_s", "time_to_goal", "_s")):
-                v = value_stats([float(r[col]) for r in ok], label, unit)
+            for col, label, unit, ci in (("path_length_m", "path_length", "_m", "t"),
+                                         ("time_to_goal_s", "time_to_goal", "_s", "bootstrap")):
+                v = value_stats([float(r[col]) for r in ok], label, unit, ci=ci)
                 v.pop(f"{label}_n")
                 row.update(v)
             row["mean_plan_time_us"] = 1e6 * float(np.mean([r["mean_plan_time_s"]

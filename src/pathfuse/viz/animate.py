@@ -265,6 +265,7 @@ class _EpisodeRenderer:
             Line2D([], [], ls="--", color="#d62728", alpha=0.6, label="sensing range"),
             Patch(fc="#ff7f0e", ec="#8a4500", label="moving obstacle (sensed)"),
             Patch(fc="#f4d3b0", ec="#8a4500", label="moving obstacle"),
+            Line2D([], [], marker="o", ls="none", color="#2ca02c", mec="k", ms=7, label="start"),
             Line2D([], [], marker="*", ls="none", color="#ffbf00", mec="k", ms=9, label="goal"),
             *map_legend_handles(drawn)[1:],  # unknown cells of a ROS map, when there are any
         ]

@@ -8,14 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from pathfuse.viz.figures import (
-    MEAN_PROPS,
-    PLANNER_COLOURS,
-    boxplot_key,
-    draw_astar,
-    draw_map,
-    plt,
-)
+from pathfuse.viz.figures import PLANNER_COLOURS, draw_astar, draw_map, plt
 
 __all__ = ["plot_fig3", "plot_r_length"]
 
@@ -63,21 +56,32 @@ def plot_fig3(results: Mapping[str, Any], seed: int, labels: Mapping[str, str],
 
 def plot_r_length(r_by_ref: Mapping[str, np.ndarray], n_maps: int, labels: Mapping[str, str],
                   out: str | Path, dpi: int = 120) -> None:
-    """Box plot of R_length = (L_fusion - L_ref) / L_ref per reference, in percent."""
-    PAPER_LABELS = labels  # noqa: N806
+    """Box plot of R_length = (L_fusion - L_ref) / L_ref per reference, in percent.
 
-    names = [k for k in r_by_ref if r_by_ref[k].size]
-    fig, ax = plt.subplots(figsize=(8, 5.2))
-    if names:
-        ax.boxplot([100 * r_by_ref[k] for k in names], showmeans=True, meanprops=MEAN_PROPS)
-        ax.set_xticks(range(1, len(names) + 1))
-        ax.set_xticklabels(
-            [f"{PAPER_LABELS.get(k, k)}\n(n={r_by_ref[k].size})" for k in names], fontsize=8)
-    ax.axhline(0.0, color="k", lw=0.8, ls="--")
-    ax.set_ylabel("R_length = (L_fusion - L_ref) / L_ref  [%]")
-    ax.set_title(f"Fusion path length relative to each reference over "
-                 f"{n_maps} maps (below 0: fusion shorter)", fontsize=10)
-    boxplot_key(fig)
-    fig.tight_layout(rect=(0, 0.7 / fig.get_figheight(), 1, 1))
-    fig.savefig(out, dpi=dpi)
-    plt.close(fig)
+    Horizontal boxes, one row per reference (its label and the number of maps both
+    planners solved on the left, the first reference at the top), as the study
+    report's box plots (:func:`pathfuse.viz.report.plot_boxes`): long labels such as
+    "Artificial potential field method" stay readable.  A dashed line marks 0.
+
+    Parameters
+    ----------
+    r_by_ref : mapping
+        Reference name -> R_length values (fractions, one per map); references
+        without a value are left out.
+    n_maps : int
+        The number of maps of the run (for the title).
+    labels : mapping
+        Reference name -> the label shown (the name itself when missing).
+    out : str or path
+        The PNG written.
+    dpi : int
+        Resolution of the PNG.
+    """
+    from pathfuse.viz.report import plot_boxes
+
+    names = [k for k in r_by_ref if np.asarray(r_by_ref[k]).size]
+    plot_boxes([labels.get(k, k) for k in names],
+               [100 * np.asarray(r_by_ref[k], dtype=float) for k in names], out,
+               xlabel="R_length = (L_fusion - L_ref) / L_ref  [%]",
+               title=f"Fusion path length relative to each reference over {n_maps} maps "
+                     "(left of 0: fusion shorter)", dpi=dpi, zero=True)

@@ -105,3 +105,47 @@ def test_no_example_skims_a_wall_with_a_margin(path, name):
     ep = simulate(sc, planner=name, robot=robot)
     if ep.collision_with != "static":
         assert ep.min_static_clearance_m >= 0.01, (name, ep.status, ep.min_static_clearance_m)
+
+
+# ------------------------------------------------------------------ the inflation (ours)
+def _corridor() -> GridMap:
+    # a 4 m square room with a pillar: the shortest path hugs the pillar's corner
+    rows = ["#" * 40] + ["#" + "." * 38 + "#"] * 38 + ["#" * 40]
+    grid = [list(r) for r in rows]
+    for r in range(15, 25):
+        for c in range(18, 22):
+            grid[r][c] = "#"
+    return GridMap.from_rows(["".join(r) for r in grid], 0.1)
+
+
+def test_a_diff_drive_robot_inflates_its_global_path_by_default():
+    from pathfuse.robot import RobotModel
+
+    assert RobotModel().inflation_m == 0.0
+    assert RobotModel.diff_drive().inflation_m == 0.3
+    g = _corridor()
+    plain = Problem.create(g, (0.8, 2.0), (3.2, 2.0), 0.2)
+    dd = Problem.create(g, (0.8, 2.0), (3.2, 2.0), 0.2, robot=RobotModel.diff_drive(
+        radius_m=0.2))
+    off = Problem.create(g, (0.8, 2.0), (3.2, 2.0), 0.2, robot=RobotModel.diff_drive(
+        radius_m=0.2, inflation_m=0.0))
+    a, b, c = plan_global(plain), plan_global(dd), plan_global(off)
+    assert a.success and b.success and c.success
+    assert np.array_equal(a.cells, c.cells)  # switched off: the exact A*
+    assert "0.3 m margin" in b.message
+    gap = lambda p: min_clearance(g, p) - 0.2  # noqa: E731
+    assert gap(a.points) < 0.1 and gap(b.points) >= 0.2
+    assert collision_free(g, b.points, 0.2)
+
+
+def test_the_inflation_key_of_a_robot_block():
+    from pathfuse.result import ConfigError
+    from pathfuse.world.robot import RobotSpec, parse_robot
+
+    assert parse_robot({"model": "diff-drive"}).to_model().inflation_m == 0.3
+    assert parse_robot({"model": "diff-drive", "inflation": 0}).to_model().inflation_m == 0.0
+    assert parse_robot({"inflation": 0.5}).to_model().inflation_m == 0.5
+    m = parse_robot({"model": "diff-drive", "inflation": 0.2}).to_model()
+    assert RobotSpec.from_model(m).to_model() == m
+    with pytest.raises(ConfigError, match=r"robot\.inflation.*-1"):
+        parse_robot({"inflation": -1})

@@ -108,7 +108,7 @@ MALFORMED = [
     ("robot.sensing_radius", "far", "robot.sensing_radius: must be a number > 0"),
     ("robot.size", 1, "robot.size: unknown key (allowed: radius, max_speed, sensing_radius, "
                       "model, max_accel, max_yaw_rate, max_yaw_accel, min_speed, clearance, "
-                      "heading, shield)"),
+                      "inflation, heading, shield, recovery)"),
     ("robot.model", "tank", "robot.model: must be one of 'holonomic', 'diff-drive', got 'tank'"),
     ("robot.max_accel", 0, "robot.max_accel: must be a number > 0"),
     ("robot.max_yaw_rate", "fast", "robot.max_yaw_rate: must be a number > 0"),

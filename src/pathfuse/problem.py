@@ -102,6 +102,13 @@ class Problem:
     clearance_m: float = 0.0
     robot: Any = None
 
+    @property
+    def inflation_m(self) -> float:
+        """The global planner's margin (ours): the larger of ``clearance_m`` and the
+        robot's ``inflation_m`` (0 without a robot)."""
+        rb = self.robot
+        return max(self.clearance_m, float(rb.inflation_m) if rb is not None else 0.0)
+
     @classmethod
     def create(cls, grid: GridMap, start: object, goal: object, robot_radius_m: float = 0.0,
                budget: Budget | None = None, clearance_m: float = 0.0,

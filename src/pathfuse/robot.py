@@ -24,7 +24,11 @@ The footprint is a disc of ``radius_m`` for both models (so turning on the
 spot never collides).  ``clearance_m`` is a *soft* safety margin (ours): the
 global planner pays a cost to come closer than it to an obstacle and the
 controllers keep it where they can (see the README's "Robots, kinematics and
-the safety margin").
+the safety margin").  ``inflation_m`` is the global planner's inflation alone
+(ours, after Nav2's inflation layer): the A* path pays a cost to pass closer
+than it to an obstacle, so it runs down the middle of passages where the map
+leaves room, while the controllers keep only the radius (and ``clearance_m``).
+A diff-drive robot gets 0.3 m by default; 0 switches it off.
 
 Examples
 --------
@@ -55,8 +59,9 @@ KINDS = ("holonomic", "diff-drive")
 """The kinematic models."""
 
 DIFF_DRIVE_DEFAULTS = {"max_accel_mps2": 2.0, "max_yaw_rate_radps": 2.0,
-                       "max_yaw_accel_radps2": 4.0}
-"""The limits a diff-drive robot gets when none is given (a small indoor base)."""
+                       "max_yaw_accel_radps2": 4.0, "inflation_m": 0.3}
+"""The limits a diff-drive robot gets when none is given (a small indoor base), and its
+global planner's inflation (ours, after Nav2's inflation layer)."""
 
 
 @dataclass(frozen=True)
@@ -81,6 +86,10 @@ class RobotModel:
         Diff-drive only: the lowest ``v`` (<= 0; negative allows reversing).
     clearance_m : float
         The soft safety margin beyond the radius (>= 0; 0 = off).
+    inflation_m : float
+        The global planner's inflation beyond the radius (>= 0; ours; 0 = off,
+        the default of a holonomic robot; a diff-drive robot gets 0.3): cells
+        closer than this to an obstacle cost more to the A* path.
     heading_rad : float or None
         Initial heading (None: facing the goal).
     shield : bool
@@ -88,6 +97,10 @@ class RobotModel:
         (:mod:`pathfuse.shield`, ours): a command is executed only when the
         robot could still stop clear of the static map after it.  True by
         default; False runs the controllers' commands as they are.
+    recovery : bool
+        Online, run a recovery behaviour when the robot stalls or oscillates
+        (:mod:`pathfuse.planners.recovery`, ours: clear the obstacle critics,
+        spin, back up or wait, each through the shield).  True by default.
     """
 
     kind: str = "holonomic"
@@ -99,8 +112,10 @@ class RobotModel:
     max_yaw_accel_radps2: float = math.inf
     min_speed_mps: float = 0.0
     clearance_m: float = 0.0
+    inflation_m: float = 0.0
     heading_rad: float | None = None
     shield: bool = True
+    recovery: bool = True
 
     def __post_init__(self) -> None:
         validate.choice(self.kind, "robot.kind", KINDS)
@@ -115,9 +130,11 @@ class RobotModel:
                                   f"got {validate.short(v)}")
         validate.number(self.min_speed_mps, "robot.min_speed_mps", le=0)
         validate.number(self.clearance_m, "robot.clearance_m", ge=0)
+        validate.number(self.inflation_m, "robot.inflation_m", ge=0)
         if self.heading_rad is not None:
             validate.number(self.heading_rad, "robot.heading_rad")
         validate.flag(self.shield, "robot.shield")
+        validate.flag(self.recovery, "robot.recovery")
         if self.kind == "holonomic" and self.min_speed_mps != 0:
             raise ConfigError("robot.min_speed_mps: a holonomic robot has no reverse speed "
                               f"(a velocity vector); got {self.min_speed_mps!r}")

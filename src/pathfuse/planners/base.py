@@ -152,6 +152,9 @@ class Controller:
         #: (indexed by :data:`pathfuse.shield.CODE_NAMES`).
         self.shield_counts = np.zeros(5, dtype=np.int64)
         self._disc_speeds: dict[int, float] = {}
+        #: Online: the recovery behaviours (:mod:`pathfuse.planners.recovery`; None until the
+        #: first command, or when the robot's ``recovery`` is off).
+        self.recovery: Any = None
 
     @property
     def acts_unicycle(self) -> bool:
@@ -188,10 +191,16 @@ class Controller:
         unless the controller plans in ``(v, omega)`` itself); then, unless the
         robot's ``shield`` is off, :mod:`pathfuse.shield` replaces it with the
         nearest command from which the robot can still stop clear of the static
-        map (:attr:`shield_counts` counts what it did).
+        map (:attr:`shield_counts` counts what it did).  When the robot stalls or
+        oscillates, a recovery behaviour (:mod:`pathfuse.planners.recovery`, ours;
+        the robot's ``recovery`` switches it) commands instead of :meth:`act`, through
+        the shield too.
         """
-        a = self.act(obs)
         rb = self.problem.robot
+        a = self._recovering(obs, rb)
+        if a is not None:  # a recovery behaviour: already in the robot's terms
+            return self._shielded(obs, a) if rb.shield else a
+        a = self.act(obs)
         if rb is None:
             return a
         if rb.is_diff_drive and not self.acts_unicycle:
@@ -202,6 +211,43 @@ class Controller:
         if not rb.shield:
             return a
         return self._shielded(obs, a)
+
+    def relax(self, seconds: float) -> bool:
+        """Recovery (ours, as Nav2's clear-costmap): drop the obstacle critics for
+        ``seconds`` and replan; True when this controller has critics to drop (the base
+        class has none)."""
+        return False
+
+    recovers: ClassVar[bool] = True
+    """Whether :meth:`command` runs the recovery behaviours (the potential-field controllers
+    have their own escape, which the paper's and pathfuse's holonomic results rest on; the
+    velocity-space fusion calls them itself)."""
+
+    def _recovering(self, obs: Observed, rb: Any, force: bool = False) -> np.ndarray | None:
+        if rb is None or not rb.recovery or not self.online or not (self.recovers or force):
+            return None
+        from pathfuse.planners.recovery import RecoveryMonitor
+
+        if self.recovery is None:
+            self.recovery = RecoveryMonitor(
+                float(self.dt), rb.is_diff_drive,  # type: ignore[arg-type]
+                rb.min_speed_mps < 0.0, rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2)
+        return self.recovery.step(obs.position, float(obs.heading),
+                                  lambda: self._path_bearing(obs), self.relax)
+
+    def _path_bearing(self, obs: Observed) -> float | None:
+        """The direction from the robot to the global path 1 m beyond its nearest point."""
+        path = self.global_path
+        if path is None or len(path) == 0:
+            return None
+        pts = np.asarray(path, dtype=np.float64).reshape(-1, 2)
+        x, y = float(obs.position[0]), float(obs.position[1])
+        i = int(np.argmin(np.hypot(pts[:, 0] - x, pts[:, 1] - y)))
+        seg = np.hypot(*np.diff(pts[i:], axis=0).T) if pts.shape[0] - i > 1 else np.zeros(0)
+        j = i + int(np.searchsorted(np.cumsum(seg), 1.0)) + 1 if seg.size else i
+        j = min(j, pts.shape[0] - 1)
+        dx, dy = float(pts[j, 0]) - x, float(pts[j, 1]) - y
+        return math.atan2(dy, dx) if dx or dy else None
 
     def _shielded(self, obs: Observed, a: np.ndarray) -> np.ndarray:
         from pathfuse.geometry import MARGIN_FRAC
@@ -272,6 +318,7 @@ class FieldController(Controller):
     """
 
     default_step_frac: ClassVar[float] = 0.1
+    recovers: ClassVar[bool] = False  # Algorithm 2's escape, and apf/ref6/ref7 as printed
     disc_reach_m: float = math.inf
     f: np.ndarray
     i: np.ndarray

@@ -26,9 +26,14 @@ then every control period:
    the end's projection on the path), *heading* (the end heading against
    the direction to the carrot, ``lookahead_m`` of path beyond that
    projection), *speed* (``(v_max - v) / v_max``),
-   *obstacle* (``exp(-gap / inflation_decay_m)`` of the least static gap
-   within ``obstacle_range_m``, as Nav2's inflation layer, plus a steep
-   penalty inside the robot's ``clearance_m``) and *moving* (a predicted
+   *path align* (the rollout's mean distance to the global path, as DWB's
+   PathAlign; not while a moving disc is sensed), *obstacle*
+   (``exp(-gap / inflation_decay_m)`` of the least static gap within
+   ``obstacle_range_m``, as Nav2's inflation layer, plus a steep penalty
+   inside the robot's ``clearance_m``), *keep* (ours: the shortfall of the
+   rollout's least gap over its first ``keep_horizon_s`` against the gap the
+   global path keeps over that stretch ahead, up to ``keep_m``, squared) and
+   *moving* (a predicted
    collision with a sensed disc: 1.5 + 2 x its depth relative to the two radii + 0.5 x how
    early it starts within the horizon, so that a swerve that makes the overlap shallower
    beats standing in the disc's way; without one, ``exp(-gap / 0.25 m)`` of the least
@@ -78,7 +83,17 @@ import numpy as np
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
-from pathfuse.planners.dwa_kernel import dwa_choose, pack_dwa
+from pathfuse.planners.dwa_kernel import (
+    D_GREF,
+    D_MARGIN,
+    D_NEAR,
+    D_VMAX,
+    D_WKEEP,
+    D_WOBS,
+    dwa_choose,
+    pack_dwa,
+    path_gap,
+)
 from pathfuse.planners.params import GlobalAStarParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -109,6 +124,16 @@ class DWAParams(GlobalAStarParams):
     heading_weight: float = param(0.3, ge=0, help="heading critic (per half turn)")
     speed_weight: float = param(0.2, ge=0, help="speed critic (slower = worse)")
     obstacle_weight: float = param(0.5, ge=0, help="obstacle critic (static gap)")
+    keep_weight: float = param(5.0, ge=0,
+                               help="keep critic (ours): the shortfall of the rollout's least "
+                                    "static gap within keep_horizon_s against the gap the "
+                                    "global path keeps ahead (up to keep_m), squared; 0 = off")
+    keep_m: float = param(0.3, gt=0, unit="m", help="keep critic: the most gap it asks for")
+    keep_horizon_s: float = param(1.0, gt=0, unit="s",
+                                  help="keep critic: how far along each rollout it looks")
+    path_align_weight: float = param(1.0, ge=0, unit="1/m",
+                                     help="path-align critic (as DWB's PathAlign): the "
+                                          "rollout's mean distance to the global path")
     moving_weight: float = param(8.0, ge=0, help="moving-disc critic (predicted collision)")
     obstacle_range_m: float = param(0.5, gt=0, unit="m",
                                     help="static gaps beyond this cost nothing")
@@ -172,10 +197,17 @@ class DWAController(Controller):
             p.v_samples, p.w_samples, p.path_weight, p.goal_weight, p.heading_weight,
             p.speed_weight, p.obstacle_weight, p.moving_weight, p.obstacle_range_m,
             p.lookahead_m, p.inflation_decay_m, not rb.is_diff_drive, ox, oy, g.resolution,
-            p.passive_safety)
+            p.passive_safety,
+            w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
+            keep_m=p.keep_m)
         self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
         self.no_choice = 0
         self._sensed = _NO_DISCS
+        self._relaxed_until = -1
+        self._f_relaxed = self.f.copy()
+        self._f_relaxed[D_WOBS] = 0.0
+        self._f_relaxed[D_MARGIN] = 0.0
+        self._f_relaxed[D_WKEEP] = 0.0
 
     def _set_path(self, pts: np.ndarray) -> None:
         gx, gy = self.problem.goal
@@ -208,16 +240,31 @@ class DWAController(Controller):
             self._set_path(np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2))
             self.global_path = self.pts
 
+    def relax(self, seconds: float) -> bool:
+        """Recovery (ours): no obstacle critic and no margin for ``seconds``, and a new
+        global path (the shield still keeps the robot clear)."""
+        self._relaxed_until = self.ticks + int(round(seconds / self.tick_s))
+        self._pending_replan = True
+        return True
+
+    _pending_replan = False
+
     def _choose(self, x: float, y: float, th: float, c0: float, c1: float, dpos: np.ndarray,
                 dvel: np.ndarray, drad: np.ndarray) -> tuple[float, float]:
-        if self.replan_every and self.ticks and self.ticks % self.replan_every == 0:
+        if self._pending_replan or (self.replan_every and self.ticks
+                                    and self.ticks % self.replan_every == 0):
+            self._pending_replan = False
             self._replan(x, y)
         self.ticks += 1
         g = self.problem.grid
         self.k = int(advance_progress(x, y, self.pts, self.cum, self.k, self.reach_m,
                                       g.occupied, float(g.origin[0]), float(g.origin[1]),
                                       float(g.resolution), self.clear_m))
-        a0, a1, count, _ = dwa_choose(self.problem.grid.occupied, self.f, x, y, th, c0, c1,
+        f = self._f_relaxed if self.ticks <= self._relaxed_until else self.f
+        if f[D_WKEEP] > 0.0:
+            f[D_GREF] = path_gap(g.occupied, f, self.pts, self.cum, self.k,
+                                 max(f[D_VMAX] * f[D_NEAR], 0.5))
+        a0, a1, count, _ = dwa_choose(self.problem.grid.occupied, f, x, y, th, c0, c1,
                                       self.pts, self.cum, self.k, dpos, dvel, drad)
         if count == 0:
             self.no_choice += 1

@@ -22,24 +22,27 @@ from pathfuse.sweep import (
     unicycle_pose,
 )
 
-__all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "N_D"]
+__all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "N_D"]
 
 (D_DT, D_VMIN, D_VMAX, D_AMAX, D_WMAX, D_ALPHA, D_RADIUS, D_CLEAR, D_MARGIN, D_HORIZON,
  D_SIMDT, D_NV, D_NW, D_WPATH, D_WGOAL, D_WHEAD, D_WSPEED, D_WOBS, D_WDYN, D_RANGE,
- D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES, D_PASSIVE) = range(27)
-N_D = 27
+ D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES, D_PASSIVE, D_WALIGN, D_NEAR, D_WKEEP, D_KEEP,
+ D_GREF) = range(32)
+N_D = 32
 SOFT = 0.3
 PASSIVE_COST = 20.0
 
 
 def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
              n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
-             decay, holonomic, ox, oy, res, passive=True):
+             decay, holonomic, ox, oy, res, passive=True, w_align=0.0, near_s=0.0,
+             w_keep=0.0, keep_m=0.3):
     """The settings array of :func:`dwa_choose`."""
     f = np.zeros(N_D)
     vals = (dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
             n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
-            decay, 1.0 if holonomic else 0.0, ox, oy, res, 1.0 if passive else 0.0)
+            decay, 1.0 if holonomic else 0.0, ox, oy, res, 1.0 if passive else 0.0,
+            w_align, near_s, w_keep, keep_m, np.inf)
     for i, v in enumerate(vals):
         f[i] = float(v)
     return f
@@ -81,6 +84,50 @@ def _local_goal(pts, cum, k, look):
     if j + 1 < m:
         j += 1
     return j
+
+
+@njit(cache=True, inline="always")
+def _path_distance(pts, cum, k, jg, x, y):
+    """Distance from ``(x, y)`` to the path's segments ``k .. jg`` and the arc length of its
+    projection (``inf`` and the path's end when there is no segment)."""
+    m = pts.shape[0]
+    pd = np.inf
+    s_at = cum[m - 1]
+    j = k
+    while j < m - 1 and j < jg:
+        ax0 = pts[j, 0]
+        ay0 = pts[j, 1]
+        vx = pts[j + 1, 0] - ax0
+        vy = pts[j + 1, 1] - ay0
+        l2 = vx * vx + vy * vy
+        tt = 0.0
+        if l2 > 0.0:
+            tt = min(max(((x - ax0) * vx + (y - ay0) * vy) / l2, 0.0), 1.0)
+        dd = math.hypot(x - (ax0 + tt * vx), y - (ay0 + tt * vy))
+        if dd < pd:
+            pd = dd
+            s_at = cum[j] + tt * (cum[j + 1] - cum[j])
+        j += 1
+    return pd, s_at
+
+
+@njit(cache=True)
+def path_gap(occ, f, pts, cum, k, length):
+    """The least gap (distance less the robot's radius) of the path from ``pts[k]`` over
+    ``length`` metres, up to ``keep_m`` (the reference of the keep critic)."""
+    m = pts.shape[0]
+    radius = f[D_RADIUS]
+    cap = radius + f[D_KEEP] + 1e-9
+    slack = MARGIN_FRAC * f[D_RES]
+    best = cap
+    j = k
+    while j + 1 < m and cum[j] - cum[k] <= length:
+        d = segment_static_distance(occ, f[D_OX], f[D_OY], f[D_RES], pts[j, 0], pts[j, 1],
+                                    pts[j + 1, 0], pts[j + 1, 1], cap, slack)
+        if d < best:
+            best = d
+        j += 1
+    return best - radius
 
 
 @njit(cache=True)
@@ -127,6 +174,13 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
         reach[j] = math.hypot(dvel[j, 0], dvel[j, 1]) * stop_s
     gmin = np.inf
     dmaxr = 0.0
+    near = f[D_NEAR]
+    dnear = cap
+    # the path-align critic holds the robot to the global path: not while a moving disc is
+    # sensed (the path may be what it crosses; the global path is replanned around it)
+    walign = f[D_WALIGN] if n_disc == 0 else 0.0
+    align = 0.0
+    n_align = 0
     tc = np.inf
     ex = x
     ey = y
@@ -149,9 +203,18 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
         if d < clear:
             if travelled < need:
                 ok = False  # it could not stop before this collision
+            if t <= near + 1e-12 and d < dnear:
+                dnear = d
             break
         if d < dmin:
             dmin = d
+        if t <= near + 1e-12 and d < dnear:
+            dnear = d
+        if walign > 0.0:
+            pdi, _ = _path_distance(pts, cum, k, jg, bx, by)
+            if pdi < np.inf:
+                align += pdi
+                n_align += 1
         for j in range(n_disc):
             pa[0] = ax
             pa[1] = ay
@@ -196,23 +259,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
     # the end point against the path near the progress index: its distance to the path and
     # how much path is left beyond its projection
     m = pts.shape[0]
-    pd = np.inf
-    s_end = cum[k]
-    j = k
-    while j < m - 1 and j < jg:
-        ax0 = pts[j, 0]
-        ay0 = pts[j, 1]
-        vx = pts[j + 1, 0] - ax0
-        vy = pts[j + 1, 1] - ay0
-        l2 = vx * vx + vy * vy
-        tt = 0.0
-        if l2 > 0.0:
-            tt = min(max(((ex - ax0) * vx + (ey - ay0) * vy) / l2, 0.0), 1.0)
-        dd = math.hypot(ex - (ax0 + tt * vx), ey - (ay0 + tt * vy))
-        if dd < pd:
-            pd = dd
-            s_end = cum[j] + tt * (cum[j + 1] - cum[j])
-        j += 1
+    pd, s_end = _path_distance(pts, cum, k, jg, ex, ey)
     if pd == np.inf:
         pd = math.hypot(ex - pts[m - 1, 0], ey - pts[m - 1, 1])
         s_end = cum[m - 1]
@@ -240,6 +287,18 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
         obs += 10.0 * (margin - gap) / margin
     out[0] = (f[D_WPATH] * pd + f[D_WGOAL] * left + f[D_WHEAD] * he
               + f[D_WSPEED] * (f[D_VMAX] - v) / f[D_VMAX] + f[D_WOBS] * obs + f[D_WDYN] * dyn)
+    if n_align > 0:
+        out[0] += walign * align / n_align
+    wkeep = f[D_WKEEP]
+    if wkeep > 0.0:
+        # ours: keep the gap the global path keeps ahead (up to keep_m): the shortfall of
+        # the least gap over the first obstacle_horizon_s, squared, relative to keep_m; a
+        # sample that keeps as much as the path pays nothing, so standing in front of a
+        # narrowing the path goes through is not cheaper than going through
+        want = min(f[D_GREF], f[D_KEEP])
+        short = want - (dnear - radius)
+        if short > 0.0 and want > 0.0:
+            out[0] += wkeep * (short / f[D_KEEP]) ** 2
 
 
 @njit(cache=True, inline="always")

@@ -168,12 +168,23 @@ class FusionController(FieldController):
         shield; otherwise as every controller (:meth:`Controller.command`)."""
         if self._window is None:
             return super().command(obs)
-        self.act(obs)
-        a = self._window.choose(obs, self._streamline(obs), self.pts, self.cum,
-                                int(self.state[S_K]))
+        self.act(obs)  # Algorithm 2 keeps up with the robot, in a recovery too
+        a = self._recovering(obs, self.problem.robot, force=True)
+        if a is None:
+            a = self._window.choose(obs, self._streamline(obs), self.pts, self.cum,
+                                    int(self.state[S_K]))
         if not self.problem.robot.shield:  # type: ignore[union-attr]
             return a
         return self._shielded(obs, a)
+
+    def relax(self, seconds: float) -> bool:
+        """Recovery (ours): the velocity-space window drops its obstacle critic for
+        ``seconds`` and follows a new A* path (:meth:`ForceWindow.relax
+        <pathfuse.planners.fusion_window.ForceWindow.relax>`)."""
+        if self._window is None:
+            return False
+        self._window.relax(seconds)
+        return True
 
     def _streamline(self, obs: Any) -> np.ndarray:
         """The robot's position and Algorithm 2's next moves from its present state (the

@@ -52,7 +52,17 @@ import numpy as np
 from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.base import sensed_discs
-from pathfuse.planners.dwa_kernel import dwa_choose, dwa_progress, pack_dwa
+from pathfuse.planners.dwa_kernel import (
+    D_GREF,
+    D_MARGIN,
+    D_NEAR,
+    D_WKEEP,
+    D_WOBS,
+    dwa_choose,
+    dwa_progress,
+    pack_dwa,
+    path_gap,
+)
 
 __all__ = ["ForceWindow", "PASSIVE_WINDOW"]
 
@@ -96,7 +106,9 @@ class ForceWindow:
             max(problem.clearance_m, rb.clearance_m), p.horizon_s, p.sim_step_s, p.v_samples,
             p.w_samples, p.path_weight, p.goal_weight, p.heading_weight, p.speed_weight,
             p.obstacle_weight, p.moving_weight, p.obstacle_range_m, p.lookahead_m,
-            p.inflation_decay_m, False, ox, oy, g.resolution, PASSIVE_WINDOW)
+            p.inflation_decay_m, False, ox, oy, g.resolution, PASSIVE_WINDOW,
+            w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
+            keep_m=p.keep_m)
         self.steps = max(1, int(math.ceil(p.horizon_s / dt)))
         """Algorithm 2's moves looked ahead each tick (the rollouts' horizon)."""
         self.min_reach_m = 0.25 * self.steps * self.vmax * dt
@@ -122,6 +134,18 @@ class ForceWindow:
         self.rec_cum = np.zeros(1)
         self.trail = np.full((self.stall_ticks, 2), np.nan)
         self.ticks = 0
+        self.relaxed_until = -1
+        self.relax_replan = False
+        self.f_relaxed = self.f.copy()
+        self.f_relaxed[D_WOBS] = 0.0
+        self.f_relaxed[D_MARGIN] = 0.0
+        self.f_relaxed[D_WKEEP] = 0.0
+
+    def relax(self, seconds: float) -> None:
+        """Recovery (ours, as Nav2's clear-costmap): no obstacle critic and no margin for
+        ``seconds``, following a new A* path (the shield keeps the robot clear)."""
+        self.relaxed_until = self.ticks + int(round(seconds / float(self.f[0])))
+        self.relax_replan = True
 
     def _replan(self, x: float, y: float) -> None:
         from pathfuse.planners.global_astar import plan_global
@@ -164,6 +188,9 @@ class ForceWindow:
         dpos, dvel, drad = sensed_discs(obs)
         lc = polyline_cumlen(local)
         net = math.hypot(float(local[-1, 0]) - x, float(local[-1, 1]) - y)
+        if self.relax_replan:
+            self.relax_replan = False
+            self._replan(x, y)
         if self._stalled(x, y):
             # recovery (ours): Algorithm 2 led the robot nowhere for 3 s; plan A* from here
             # and follow that path for 4 s
@@ -189,7 +216,14 @@ class ForceWindow:
         err = _wrap(math.atan2(float(path[j, 1]) - y, float(path[j, 0]) - x) - th)
         if abs(err) > self.rotate_rad:
             return self._rotate(err)
-        a0, a1, _, _ = dwa_choose(self.problem.grid.occupied, self.f, x, y,
+        f = self.f_relaxed if self.ticks <= self.relaxed_until else self.f
+        if f[D_WKEEP] > 0.0:
+            # the keep critic's reference: the gap the A* path keeps ahead (the local path
+            # is the field's streamline, which may graze)
+            kk0 = min(max(int(k), 0), pts.shape[0] - 1)
+            f[D_GREF] = path_gap(self.problem.grid.occupied, f, pts, cum, kk0,
+                                 max(self.vmax * float(f[D_NEAR]), 0.5))
+        a0, a1, _, _ = dwa_choose(self.problem.grid.occupied, f, x, y,
                                   float(obs.heading), float(cmd[0]), float(cmd[1]), path, pcum,
                                   kk, dpos, dvel, drad)
         if a0 <= 0.0 and float(cmd[0]) <= 0.0 and abs(err) > 0.05:

@@ -10,9 +10,11 @@ map's edge grown by the radius; the map itself for a point robot).
 * :attr:`GlobalPlan.points` are the cell centres from the start cell to the
   goal cell: the grid path, whose length is the A* cost
   (:attr:`GlobalPlan.length_m`).  This is what the ``astar`` planner returns.
-* With a safety margin (``problem.clearance_m > 0``, ours) the search pays
-  a clearance cost near obstacles (:mod:`pathfuse.search.costaware`);
-  ``length_m`` is then the path's length, not its cost.
+* With a safety margin or an inflation (:attr:`Problem.inflation_m` > 0:
+  ``clearance_m``, or the robot's ``inflation_m``, 0.3 m by default for a
+  diff-drive robot; ours) the search pays a clearance cost near obstacles
+  (:mod:`pathfuse.search.costaware`); ``length_m`` is then the path's
+  length, not its cost.
 * :attr:`GlobalPlan.waypoints` are what a controller follows:
   ``[start, centres..., goal]``, the first and last centres left out when
   the straight move past them is clear (on a query between cell centres the
@@ -171,7 +173,7 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
     else:
         sc, gc = problem.start_cell, problem.goal_cell
     budget = problem.budget
-    if problem.clearance_m > 0:
+    if problem.inflation_m > 0:
         return _plan_with_margin(problem, occ, sc, gc, heuristic, corner_cutting,
                                  max_expansions)
     if occupied is None:
@@ -220,7 +222,8 @@ def _plan_with_margin(problem: Problem, occ: np.ndarray, sc: tuple[int, int],
         warmup_costaware()  # compilation stays out of time_s
         _WARM_COST.append(True)
     grid = problem.grid
-    mult = clearance_multipliers(grid, problem.robot_radius_m, problem.clearance_m)
+    margin = problem.inflation_m
+    mult = clearance_multipliers(grid, problem.robot_radius_m, margin)
     t0 = time.perf_counter()
     code, cells, cost, exp = costaware_search(occ, mult, sc, gc, corner_cutting,
                                               max_expansions)
@@ -239,7 +242,7 @@ def _plan_with_margin(problem: Problem, occ: np.ndarray, sc: tuple[int, int],
     length = float(np.hypot(*np.diff(pts, axis=0).T).sum()) if len(pts) > 1 else 0.0
     return GlobalPlan(Status.SUCCESS, cells, pts, problem, length, exp, elapsed,
                       f"path through {len(cells)} cells, {length:.6g} m, keeping a "
-                      f"{problem.clearance_m:g} m margin where it can (cost {cost * res:.6g}), "
+                      f"{margin:g} m margin where it can (cost {cost * res:.6g}), "
                       f"{exp} expansions", heuristic, corner_cutting)
 
 

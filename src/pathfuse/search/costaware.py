@@ -49,25 +49,32 @@ _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 @njit(cache=True)
 def _gaps(occ, res, k, cap):
-    """Exact distance from each cell centre to the nearest occupied square (capped)."""
+    """Exact distance from each cell centre to the nearest occupied square (capped).
+
+    Only the occupied cells with a free 4-neighbour are visited (the nearest
+    point of the occupied squares to a free centre always lies on one of
+    them), each updating the cells within ``k`` of it.
+    """
     h, w = occ.shape
     out = np.full((h, w), cap)
     for r in range(h):
-        cy = (r + 0.5) * res
         for c in range(w):
-            if occ[r, c]:
-                out[r, c] = 0.0
+            if not occ[r, c]:
                 continue
-            cx = (c + 0.5) * res
-            best = cap
+            out[r, c] = 0.0
+            if not ((r > 0 and not occ[r - 1, c]) or (r + 1 < h and not occ[r + 1, c])
+                    or (c > 0 and not occ[r, c - 1]) or (c + 1 < w and not occ[r, c + 1])):
+                continue
+            x0 = c * res
+            y0 = r * res
             for rr in range(max(r - k, 0), min(r + k + 1, h)):
+                cy = (rr + 0.5) * res
                 for cc in range(max(c - k, 0), min(c + k + 1, w)):
                     if occ[rr, cc]:
-                        d = point_box_distance(cx, cy, cc * res, rr * res, (cc + 1) * res,
-                                               (rr + 1) * res)
-                        if d < best:
-                            best = d
-            out[r, c] = best
+                        continue
+                    d = point_box_distance((cc + 0.5) * res, cy, x0, y0, x0 + res, y0 + res)
+                    if d < out[rr, cc]:
+                        out[rr, cc] = d
     return out
 
 

@@ -17,7 +17,8 @@ from pathfuse.robot import KINDS, RobotModel
 __all__ = ["RobotSpec", "parse_robot", "ROBOT_KEYS"]
 
 ROBOT_KEYS = ("radius", "max_speed", "sensing_radius", "model", "max_accel", "max_yaw_rate",
-              "max_yaw_accel", "min_speed", "clearance", "heading", "shield")
+              "max_yaw_accel", "min_speed", "clearance", "inflation", "heading", "shield",
+              "recovery")
 """The keys of a ``robot:`` block."""
 
 
@@ -52,11 +53,18 @@ class RobotSpec:
     clearance : float or None
         Soft safety margin beyond the radius (m; ours; 0 = off); None: the
         model's default (0).
+    inflation : float or None
+        The global planner's inflation beyond the radius (m; ours; 0 = off);
+        None: the model's default (0.3 for a diff-drive robot, 0 for a
+        holonomic one).
     heading : float or None
         Initial heading (rad; None: facing the goal).
     shield : bool
         Pass every command through the safety shield (ours; default true;
         :mod:`pathfuse.shield`).
+    recovery : bool
+        Run recovery behaviours when the robot stalls or oscillates (ours;
+        default true; :mod:`pathfuse.planners.recovery`).
     """
 
     radius: float = 0.2
@@ -68,17 +76,22 @@ class RobotSpec:
     max_yaw_accel: float | None = None
     min_speed: float = 0.0
     clearance: float | None = None
+    inflation: float | None = None
     heading: float | None = None
     shield: bool = True
+    recovery: bool = True
 
     def to_model(self) -> RobotModel:
         """The :class:`~pathfuse.robot.RobotModel` of this block (defaults filled in)."""
         kw: dict[str, Any] = {"radius_m": self.radius, "max_speed_mps": self.max_speed,
                               "sensing_radius_m": self.sensing_radius,
                               "min_speed_mps": self.min_speed,
-                              "heading_rad": self.heading, "shield": self.shield}
+                              "heading_rad": self.heading, "shield": self.shield,
+                              "recovery": self.recovery}
         if self.clearance is not None:
             kw["clearance_m"] = self.clearance
+        if self.inflation is not None:
+            kw["inflation_m"] = self.inflation
         for key, attr in (("max_accel_mps2", "max_accel"),
                           ("max_yaw_rate_radps", "max_yaw_rate"),
                           ("max_yaw_accel_radps2", "max_yaw_accel")):
@@ -99,7 +112,8 @@ class RobotSpec:
                    sensing_radius=m.sensing_radius_m, model=m.kind,
                    max_accel=lim(m.max_accel_mps2), max_yaw_rate=lim(m.max_yaw_rate_radps),
                    max_yaw_accel=lim(m.max_yaw_accel_radps2), min_speed=m.min_speed_mps,
-                   clearance=m.clearance_m, heading=m.heading_rad, shield=m.shield)
+                   clearance=m.clearance_m, inflation=m.inflation_m, heading=m.heading_rad,
+                   shield=m.shield, recovery=m.recovery)
 
 
 def parse_robot(v: Any, error: type[ConfigError] = ConfigError) -> RobotSpec:
@@ -128,6 +142,8 @@ def parse_robot(v: Any, error: type[ConfigError] = ConfigError) -> RobotSpec:
         max_yaw_accel=opt("max_yaw_accel", gt=0),
         min_speed=num("min_speed", le=0),
         clearance=opt("clearance", ge=0),
+        inflation=opt("inflation", ge=0),
         heading=opt("heading"),
         shield=validate.flag(m.get("shield", d.shield), "robot.shield", error),
+        recovery=validate.flag(m.get("recovery", d.recovery), "robot.recovery", error),
     )

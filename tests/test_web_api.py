@@ -30,11 +30,12 @@ from pathfuse.web.maps import Limits, grid_from_bits, grid_to_json
 DATA = Path(__file__).parent / "data"
 ROOT = Path(__file__).resolve().parents[1]
 ROS = DATA / "ros" / "nav2_tb3_sandbox"
+BASE = "http://127.0.0.1"  # the server answers loopback Host names only (by default)
 
 
 @pytest.fixture(scope="module")
 def client():
-    with TestClient(create_app()) as c:
+    with TestClient(create_app(), base_url=BASE) as c:
         yield c
 
 
@@ -106,7 +107,8 @@ def test_planners_loop_over_the_registry(client):
         assert ("closed" in p["layers"]) == spec.uses_astar
     fusion = next(p for p in got if p["name"] == "fusion")
     r1 = next(q for q in fusion["params"] if q["name"] == "r1_m")
-    assert r1["unit"] == "m" and r1["gt"] == 0 and r1["accepts"] == "number > 0 m"
+    assert r1["unit"] == "m" and r1["gt"] == 0 and r1["le"] == 100
+    assert r1["accepts"] == "number > 0 and <= 100 m"
     ahead = next(q for q in fusion["params"] if q["name"] == "ahead")
     assert ahead["kind"] == "choice" and ahead["choices"] == ["progress", "paper-x"]
     assert "attractors" in fusion["layers"]
@@ -346,7 +348,7 @@ def test_plan_bad_input(client, body, message):
 
 
 def test_bodies_that_are_not_json_or_too_big():
-    with TestClient(create_app(limits=Limits(max_body_bytes=1000))) as c:
+    with TestClient(create_app(limits=Limits(max_body_bytes=1000)), base_url=BASE) as c:
         r = c.post("/api/plan", content=b"{not json", headers={"content-type": "application/json"})
         assert r.status_code == 400 and r.json()["error"].startswith("request body: not valid JSON")
         r = c.post("/api/plan", content=b"\xff\xfe", headers={"content-type": "application/json"})
@@ -391,7 +393,8 @@ def test_a_planner_that_raises_is_a_500_with_its_message(client):
 
 def test_a_request_over_the_budget_is_503():
     _sleepy(1.5)
-    with TestClient(create_app(limits=Limits(time_budget_s=0.1, grace_s=0.2))) as c:
+    with TestClient(create_app(limits=Limits(time_budget_s=0.1, grace_s=0.2)),
+                    base_url=BASE) as c:
         t0 = time.perf_counter()
         r = c.post("/api/plan", json={"map": "paper", "planner": "nap"})
         assert time.perf_counter() - t0 < 1.2
@@ -408,7 +411,7 @@ def test_planners_run_off_the_event_loop():
 
     async def run():
         transport = httpx.ASGITransport(app=app)
-        async with httpx.AsyncClient(transport=transport, base_url="http://t") as c:
+        async with httpx.AsyncClient(transport=transport, base_url=BASE) as c:
             done = {}
 
             async def slow():
@@ -640,7 +643,8 @@ def test_upload_of_an_image_without_resolution_says_so(client, tmp_path):
 def test_upload_limits(tmp_path):
     from PIL import Image
 
-    with TestClient(create_app(limits=Limits(max_upload_bytes=5000, max_cells=1000))) as c:
+    with TestClient(create_app(limits=Limits(max_upload_bytes=5000, max_cells=1000)),
+                    base_url=BASE) as c:
         big = (DATA / "movingai" / "den312d.map").read_bytes()
         r = _upload(c, ("den312d.map", big))
         assert r.status_code == 413 and "limit of 5000 bytes" in r.json()["error"]

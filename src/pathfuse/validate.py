@@ -266,17 +266,34 @@ class ParamSpec:
         """The checked (and normalised: ints to floats) value."""
         if value is None and self.optional:
             return None
+        # a value below the lower bound is told that bound alone (the message it always had);
+        # a value above the upper bound is told the whole range
         if self.kind == "float":
-            return number(value, key, gt=self.gt, ge=self.ge, le=self.le, error=error)
+            v = number(value, key, gt=self.gt, ge=self.ge, error=error)
+            if self.le is not None and not v <= self.le:
+                raise _fail(key, "a number " + _bounds(self.gt, self.ge, None, self.le), value,
+                            error)
+            return v
         if self.kind == "int":
             ge = None if self.ge is None else int(self.ge)
             le = None if self.le is None else int(self.le)
-            return integer(value, key, ge=ge, le=le, error=error)
+            n = integer(value, key, ge=ge, error=error)
+            if le is not None and n > le:
+                raise _fail(key, "an integer " + self._range(), value, error)
+            return n
         if self.kind == "bool":
             return flag(value, key, error)
         if self.kind == "choice":
             return choice(value, key, self.choices, error)
         return text(value, key, error)
+
+    def _range(self) -> str:
+        """The bounds in words (an integer's bounds as integers, every digit)."""
+        if self.kind != "int":
+            return _bounds(self.gt, self.ge, None, self.le)
+        parts = [f"{op} {int(v)}" for op, v in ((">", self.gt), (">=", self.ge), ("<=", self.le))
+                 if v is not None]
+        return " and ".join(parts)
 
     def describe(self) -> str:
         """The constraint in words: ``"> 0 m"``, ``"one of 'a', 'b'"``."""
@@ -284,7 +301,7 @@ class ParamSpec:
             return "one of " + ", ".join(repr(c) for c in self.choices)
         if self.kind == "bool":
             return "true or false"
-        b = _bounds(self.gt, self.ge, None, self.le)
+        b = self._range()
         kind = {"float": "number", "int": "integer", "str": "text"}.get(self.kind, self.kind)
         optional = " or null" if self.optional else ""
         return " ".join(x for x in (kind, b, self.unit) if x) + optional

@@ -496,10 +496,11 @@ def cmd_report(args: argparse.Namespace) -> int:
 def cmd_serve(args: argparse.Namespace) -> int:
     """``pathfuse serve``: the planning playground in the browser (uvicorn + Starlette)."""
     try:
-        import uvicorn
+        import uvicorn  # noqa: F401 - the extra's check
 
-        from pathfuse.web.app import create_app, default_map_folders
+        from pathfuse.web.app import default_map_folders
         from pathfuse.web.maps import Limits
+        from pathfuse.web.serve import serve
     except ImportError as exc:
         raise CliError(f"the web app needs its extra: pip install \"pathfuse[web]\" "
                        f"({exc.name} is missing)") from None
@@ -511,24 +512,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         folders.append((p.resolve().name, p))
     limits = Limits(max_cells=args.max_cells, max_upload_bytes=args.max_upload_mb * 1024 * 1024,
                     time_budget_s=args.budget)
-    app = create_app(map_folders=folders, limits=limits, workers=args.workers,
-                     warm=not args.no_warm)
-    host = args.host
-    url = f"http://{'[' + host + ']' if ':' in host else host}:{args.port}/"
-    if host not in ("127.0.0.1", "localhost", "::1"):
-        print(f"pathfuse serve: listening on {host}: anyone who can reach this machine can use "
-              "the app", file=sys.stderr)
-    print(f"pathfuse serve: {url}  (Ctrl-C stops it)", file=sys.stderr, flush=True)
-    if args.open:
-        import threading
-        import webbrowser
-
-        threading.Timer(1.0, lambda: webbrowser.open(url)).start()
-    config = uvicorn.Config(app, host=host, port=args.port, log_level=args.log_level,
-                            timeout_keep_alive=5, limit_concurrency=64)
-    server = uvicorn.Server(config)
-    try:
-        server.run()
-    except OSError as exc:
-        raise CliError(f"cannot listen on {host}:{args.port}: {exc.strerror or exc}") from None
-    return 0
+    return serve(host=args.host, port=args.port, map_folders=folders, limits=limits,
+                 workers=args.workers, max_queue=args.queue, warm=not args.no_warm,
+                 allow_hosts=args.allow_host or [], open_browser=args.open,
+                 log_level=args.log_level)

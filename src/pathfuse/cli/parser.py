@@ -339,6 +339,18 @@ with one configuration; by default R_length is against the experiment's own refe
     return parser
 
 
+def _port(text: str) -> int:
+    """An argparse type: a TCP port, 0 (any free port) to 65535."""
+    try:
+        v = int(text)
+    except ValueError:
+        v = -1
+    if not 0 <= v <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port from 0 to 65535 (0: any free "
+                                         f"port), got {text[:40]!r}")
+    return v
+
+
 def _add_serve(sub: argparse._SubParsersAction) -> None:
     """``pathfuse serve``: the planning playground in the browser."""
     w = sub.add_parser(
@@ -346,31 +358,43 @@ def _add_serve(sub: argparse._SubParsersAction) -> None:
         description="Start a local web app: draw or load a map, drag start and goal, run "
         "any registered planners side by side, look at the potential field, the A* closed "
         "set and the c-space, and play moving-obstacle episodes.  Its JSON API is "
-        "documented in the README.  Binds to 127.0.0.1 unless --host says otherwise.",
+        "documented in the README.  Binds to 127.0.0.1 unless --host says otherwise, and "
+        "answers requests that name a loopback host (localhost, 127.0.0.1, ::1) unless "
+        "--allow-host adds names.  Every computation runs in a worker process that is "
+        "stopped at the --budget.",
         epilog=_fmt("""
 examples:
   pathfuse serve --open
   pathfuse serve --port 8080 --maps tests/data/movingai
-  pathfuse serve --host 0.0.0.0 --port 8000     # reachable from other machines
+  pathfuse serve --host 0.0.0.0 --allow-host mybox.lan   # reachable from other machines
 
 Needs the web extra: pip install "pathfuse[web]".
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     w.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
-    w.add_argument("--port", type=_nonneg_int, default=8000, help="port (default 8000)")
+    w.add_argument("--port", type=_port, default=8000,
+                   help="port, 0 to 65535 (default 8000; 0: any free port)")
+    w.add_argument("--allow-host", action="append", metavar="NAME",
+                   help="a host name requests may use besides localhost, 127.0.0.1 and ::1 "
+                   "(and --host), repeatable; '*' allows any (DNS rebinding can then reach "
+                   "the app)")
     w.add_argument("--open", action="store_true", help="open the page in a web browser")
     w.add_argument("--maps", action="append", metavar="DIR",
                    help="a folder of maps and scenario files to offer, repeatable (default: "
                    "examples/ and tests/data/ of the source tree, when present)")
-    w.add_argument("--budget", type=_positive_float, default=20.0,
-                   help="seconds one request may compute (default 20)")
+    w.add_argument("--budget", type=_positive_float, default=8.0,
+                   help="seconds one request may take, waiting for a worker included; its "
+                   "worker process is stopped 1 s past it (default 8)")
     w.add_argument("--max-cells", type=_positive_int, default=2048 * 2048,
                    help="cells of any map (default 4194304 = 2048 x 2048)")
     w.add_argument("--max-upload-mb", type=_positive_int, default=32,
                    help="size of an upload in MiB (default 32)")
-    w.add_argument("--workers", type=_positive_int, default=2,
-                   help="requests computed at once, each in a thread (default 2)")
+    w.add_argument("--workers", type=_positive_int, default=3,
+                   help="worker processes: requests computed at once (default 3)")
+    w.add_argument("--queue", type=_nonneg_int, default=32,
+                   help="requests that may wait for a worker; more are answered 503 with "
+                   "Retry-After (default 32)")
     w.add_argument("--no-warm", action="store_true",
                    help="do not compile the planners' kernels when the server starts")
     w.add_argument("--log-level", default="warning",

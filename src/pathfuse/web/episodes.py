@@ -125,19 +125,20 @@ def scenario_json(store: MapStore, sc: Any) -> dict[str, Any]:
 
 def load_catalog_scenario(store: MapStore, scenario_id: str) -> dict[str, Any]:
     """``GET /api/scenarios/{id}``: a scenario of the catalog (a file the server found)."""
+    from pathfuse.web.files import check_scenario_cells
     from pathfuse.world.scenario import load_scenario
 
     path = store.scenarios.get(scenario_id)
     if path is None:
         raise ApiError(404, f"scenario: no scenario with id {validate.short(scenario_id)} on "
                             "this server (GET /api/scenarios lists them)")
+    check_scenario_cells(path, store.limits, scenario_id)
     return scenario_json(store, load_scenario(path))
 
 
 def upload_scenario(store: MapStore, name: str, data: bytes, limits: Limits) -> dict[str, Any]:
     """``POST /api/scenarios``: read an uploaded scenario YAML (its map must not name a file)."""
-    import yaml
-
+    from pathfuse.safeyaml import load_yaml
     from pathfuse.world.scenario import load_scenario
 
     base = os.path.basename(str(name).replace("\\", "/")) or "scenario.yaml"
@@ -145,19 +146,15 @@ def upload_scenario(store: MapStore, name: str, data: bytes, limits: Limits) -> 
     if not safe.lower().endswith((".yaml", ".yml")):
         safe = (safe or "scenario") + ".yaml"
     try:
-        doc = yaml.safe_load(data.decode("utf-8"))
+        data.decode("utf-8")
     except UnicodeDecodeError:
         raise ConfigError(f"{safe}: not a UTF-8 text file") from None
-    except yaml.YAMLError:
+    try:
+        doc = load_yaml(data, safe)
+    except PathfuseError:
         doc = None  # load_scenario below names the line
     if isinstance(doc, Mapping):
-        m = doc.get("map")
-        files = [k for k in ("movingai", "ros", "image", "npy") if isinstance(m, Mapping)
-                 and k in m]
-        if files or (isinstance(m, str) and m.strip().lower() != "paper"):
-            raise ApiError(400, f"{safe}: map: the server reads no file a scenario names; "
-                                "use a paper, random or rows map, or export the scene from "
-                                "the page")
+        _check_scenario_map(store, doc.get("map"), safe)
         obstacles = doc.get("obstacles")
         if isinstance(obstacles, list):
             check_budget_inputs(limits, 0, len(obstacles))
@@ -171,3 +168,24 @@ def upload_scenario(store: MapStore, name: str, data: bytes, limits: Limits) -> 
     check_budget_inputs(limits, sc.n_steps, len(sc.obstacles))
     sc = sc.replace(source=None)
     return scenario_json(store, sc)
+
+
+_SCENARIO_SOURCES = ("paper", "random", "rows")
+
+
+def _check_scenario_map(store: MapStore, m: Any, where: str) -> None:
+    """A scenario file's map must be generated (paper, random, rows) and within the cell
+    limit; anything else, a file name above all, is refused before the file is loaded."""
+    refuse = ApiError(400, f"{where}: map: the server reads no file a scenario names; use a "
+                           "paper, random or rows map, or export the scene from the page")
+    if isinstance(m, str):
+        if m.strip().lower() != "paper":
+            raise refuse
+        return
+    if not isinstance(m, Mapping):
+        return  # load_scenario names the problem
+    sources = [k for k in m if k in _SCENARIO_SOURCES]
+    if len(sources) != 1 or any(k not in _SCENARIO_SOURCES and k not in
+                                ("resolution", "origin", "name") for k in m):
+        raise refuse
+    store.check_spec_size(m, f"{where}: map")

@@ -14,25 +14,25 @@ A request never names a file on the server's disk.  A map in a request is one of
                                                    folders) or an upload, by its id
 =================================================  =========================================
 
+This table is an allow-list (:data:`REQUEST_SOURCES`): any other key, the
+file sources of scenario files (``movingai``, ``ros``, ``image``, ``npy``,
+``gazebo``) included, is refused with the same answer whether or not the value
+names a file that exists, and nothing is read.
+
 Catalog ids are keys of a table built when the server starts; an id that is
-not in the table is a 404, whatever it looks like.  Uploads are written to a
-fresh temporary folder under the names the server chooses and read with
-:func:`pathfuse.load_map`, after size and cell-count checks that read only
-the files' headers.
+not in the table is a 404, whatever it looks like.  Uploads are read by
+:mod:`pathfuse.web.files`.  Every map, of the catalog too, is checked against
+``Limits.max_cells`` before its grid is allocated.
 """
 
 from __future__ import annotations
 
 import base64
 import hashlib
-import io
-import math
 import os
-import tempfile
 import threading
-import zipfile
 from collections import OrderedDict
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -40,59 +40,25 @@ from typing import Any
 import numpy as np
 
 from pathfuse.grid import GridMap
-from pathfuse.result import ConfigError, MapFormatError, PathfuseError
+from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.web.limits import ApiError, Limits, _cells_ok
 
 __all__ = [
     "Limits",
     "ApiError",
     "MapEntry",
     "MapStore",
+    "REQUEST_SOURCES",
+    "request_source",
     "grid_to_json",
     "grid_from_bits",
-    "read_upload",
 ]
 
-
-class ApiError(PathfuseError):
-    """A request the server refuses, with its HTTP status."""
-
-    def __init__(self, status: int, message: str) -> None:
-        super().__init__(message)
-        self.status = status
-
-
-@dataclass(frozen=True)
-class Limits:
-    """What one request may ask for (``pathfuse serve`` options set them).
-
-    Attributes
-    ----------
-    max_cells : int
-        Cells of any map (uploaded, generated, blank or sent back edited).
-    max_upload_bytes : int
-        Size of an upload request (every file together).
-    max_body_bytes : int
-        Size of a JSON request body.
-    time_budget_s : float
-        Wall time of one request's computation; planners get it as their
-        ``Budget.time_limit_s``.
-    max_ticks : int
-        Ticks of one simulated episode.
-    max_discs : int
-        Moving discs of one scenario.
-    grace_s : float
-        How long past ``time_budget_s`` the server waits for a computation
-        before it answers 503 (a planner stops at its budget, but the
-        metrics and layers around it take a little longer).
-    """
-
-    max_cells: int = 2048 * 2048
-    max_upload_bytes: int = 32 * 1024 * 1024
-    max_body_bytes: int = 16 * 1024 * 1024
-    time_budget_s: float = 20.0
-    max_ticks: int = 20000
-    max_discs: int = 64
-    grace_s: float = 5.0
+REQUEST_SOURCES = ("paper", "random", "rows", "blank", "grid", "id")
+"""The map sources a request may name (the allow-list); none of them reads a file."""
+_COMPANIONS: dict[str, tuple[str, ...]] = {
+    "paper": (), "random": ("name",), "rows": ("resolution", "origin", "name"),
+    "blank": (), "grid": (), "id": ()}
 
 
 # --------------------------------------------------------------------------- JSON form
@@ -123,12 +89,6 @@ def pack_mask(mask: np.ndarray) -> str:
     """base64 of ``numpy.packbits`` of a bool array, row-major (as ``bits`` above)."""
     return base64.b64encode(np.packbits(np.ascontiguousarray(mask).ravel()).tobytes()
                             ).decode("ascii")
-
-
-def _cells_ok(w: int, h: int, limits: Limits, what: str) -> None:
-    if w * h > limits.max_cells:
-        raise ApiError(413, f"{what}: {w} x {h} = {w * h} cells is more than this server's "
-                            f"limit of {limits.max_cells} cells")
 
 
 def _int_field(d: Mapping[str, Any], key: str, where: str) -> int:
@@ -185,14 +145,24 @@ class MapEntry:
     goal: tuple[float, float] | None = None
     info: dict[str, Any] = field(default_factory=dict)
 
-
-_MAP_SPEC_KEYS = ("paper", "random", "rows")
+    def portable(self) -> MapEntry:
+        """A copy to send to another process: the grid without its caches (c-space,
+        distance field, search buffers), which the other process builds when it needs
+        them."""
+        g = self.grid
+        if g is not None:
+            g = GridMap(g.occupied, g.resolution, g.origin, name=g.name, meta=dict(g.meta))
+        return MapEntry(self.id, self.name, self.kind, None, g, self.spec, self.start,
+                        self.goal, dict(self.info))
 
 
 class MapStore:
     """The catalog (files found when the server starts) and the uploads (kept in memory).
 
-    Thread-safe; uploads and edited grids are kept in bounded LRU tables.
+    Thread-safe; uploads and edited grids are kept in bounded LRU tables.  In a worker
+    process (:meth:`worker_mode`) the uploads table is a cache: an id it does not hold
+    is asked of the server process, and the maps the worker adds are handed back to it
+    (:meth:`take_added`, :meth:`adopt`).
     """
 
     def __init__(self, folders: list[tuple[str, Path]] | None = None,
@@ -203,9 +173,45 @@ class MapStore:
         self._uploads: OrderedDict[str, MapEntry] = OrderedDict()
         self._grids: OrderedDict[str, GridMap] = OrderedDict()
         self._max_uploads = max_uploads
+        self._fetch: Callable[[str], MapEntry | None] | None = None
+        self._added: list[MapEntry] = []
         self.scenarios: dict[str, Path] = {}
         for label, folder in folders or []:
             self._scan(label, Path(folder))
+
+    # ------------------------------------------------------------------ worker processes
+    def worker_mode(self, fetch: Callable[[str], MapEntry | None],
+                    max_uploads: int = 8) -> None:
+        """Make this (forked) copy a worker's: uploads come from ``fetch`` and are cached
+        (at most ``max_uploads``); the lock is a new one (the server's may have been held
+        by another thread when the process was forked)."""
+        self._lock = threading.Lock()
+        self._uploads = OrderedDict()
+        self._max_uploads = max_uploads
+        self._fetch = fetch
+        self._added = []
+
+    def take_added(self) -> list[MapEntry]:
+        """The maps added since the last call (worker mode), ready to send."""
+        out, self._added = [e.portable() for e in self._added], []
+        return out
+
+    def adopt(self, entries: list[MapEntry]) -> None:
+        """Keep maps a worker added, under the ids the worker gave them."""
+        with self._lock:
+            for e in entries:
+                self._uploads[e.id] = e
+                self._uploads.move_to_end(e.id)
+            while len(self._uploads) > self._max_uploads:
+                self._uploads.popitem(last=False)
+
+    def upload_entry(self, map_id: str) -> MapEntry | None:
+        """The upload ``map_id`` ready to send to a worker, or None."""
+        with self._lock:
+            e = self._uploads.get(map_id)
+            if e is not None:
+                self._uploads.move_to_end(map_id)
+        return None if e is None else e.portable()
 
     # ------------------------------------------------------------------ catalog
     def _scan(self, label: str, folder: Path) -> None:
@@ -223,7 +229,7 @@ class MapStore:
             suffix = p.suffix.lower()
             if suffix in (".yaml", ".yml"):
                 kind = _yaml_kind(p)
-                if kind == "scenario" and _loads(p):
+                if kind == "scenario" and _loads(p, self.limits):
                     self.scenarios[rel] = p
                 elif kind == "map":
                     self._catalog[rel] = MapEntry(rel, p.name, "catalog", p)
@@ -239,13 +245,22 @@ class MapStore:
         return out
 
     def get(self, map_id: str) -> MapEntry:
-        """The entry of ``map_id`` with its grid loaded; :class:`ApiError` 404 otherwise."""
+        """The entry of ``map_id`` with its grid loaded; :class:`ApiError` 404 otherwise.
+
+        A catalog file is checked against the cell limit before it is read, and its
+        messages name it by its id, not by its path on the server.
+        """
         with self._lock:
             e = self._uploads.get(map_id)
             if e is not None:
                 self._uploads.move_to_end(map_id)
                 return e
             e = self._catalog.get(map_id)
+        if e is None and self._fetch is not None and map_id.startswith("upload-"):
+            e = self._fetch(map_id)
+            if e is not None:
+                self._keep(e)
+                return e
         if e is None:
             raise ApiError(404, f"map: no map with id {_short(map_id)} on this server "
                                 "(GET /api/maps lists them)")
@@ -253,18 +268,32 @@ class MapStore:
             from pathfuse.io import load_map
 
             assert e.path is not None
-            e.grid = load_map(e.path)
+            from pathfuse.web.files import check_file_cells
+
+            try:
+                check_file_cells(e.path, self.limits, name=e.id)
+                e.grid = load_map(e.path)
+            except ApiError as exc:
+                raise ApiError(exc.status, _hide(str(exc), e.path, e.id)) from None
+            except PathfuseError as exc:
+                raise type(exc)(_hide(str(exc), e.path, e.id)) from None
+            _cells_ok(e.grid.width, e.grid.height, self.limits, e.id)
         return e
+
+    def _keep(self, e: MapEntry) -> None:
+        with self._lock:
+            self._uploads[e.id] = e
+            while len(self._uploads) > self._max_uploads:
+                self._uploads.popitem(last=False)
 
     def add_upload(self, grid: GridMap, name: str, spec: Any = None) -> MapEntry:
         """Keep an uploaded (or generated) grid; returns its entry with a fresh id."""
         digest = hashlib.sha1(grid.occupied.tobytes()).hexdigest()[:10]
         map_id = f"upload-{digest}-{os.urandom(3).hex()}"
         e = MapEntry(map_id, name, "upload", grid=grid, spec=spec)
-        with self._lock:
-            self._uploads[map_id] = e
-            while len(self._uploads) > self._max_uploads:
-                self._uploads.popitem(last=False)
+        self._keep(e)
+        if self._fetch is not None:
+            self._added.append(e)
         return e
 
     # ------------------------------------------------------------------ requests
@@ -285,22 +314,15 @@ class MapStore:
         if not isinstance(spec, Mapping):
             raise ConfigError(f"{where}: must be 'paper', a map id or a map spec mapping, got "
                               f"{validate.short(spec)}")
-        if "id" in spec:
-            validate.mapping(spec, where, ("id",))
+        source = request_source(spec, where)
+        if source == "id":
             e = self.get(validate.text(spec["id"], f"{where}.id"))
             return e.grid, e.spec  # type: ignore[return-value]
-        if "grid" in spec:
-            validate.mapping(spec, where, ("grid",))
+        if source == "grid":
             return self._edited(spec["grid"], f"{where}.grid"), None
-        if "blank" in spec:
-            validate.mapping(spec, where, ("blank",))
+        if source == "blank":
             return self._blank(spec["blank"], f"{where}.blank"), None
-        files = [k for k in spec if k not in _MAP_SPEC_KEYS and k in
-                 ("movingai", "ros", "image", "npy")]
-        if files:
-            raise ApiError(400, f"{where}.{files[0]}: the server reads no file a request "
-                                "names; upload the map (POST /api/maps) and use its id")
-        self._check_spec_size(spec, where)
+        self.check_spec_size(spec, where)
         from pathfuse.io import map_from_spec
 
         try:
@@ -309,21 +331,11 @@ class MapStore:
             raise type(exc)(f"{where}: {exc}") from None
         return grid, dict(spec)
 
-    def _check_spec_size(self, spec: Mapping[str, Any], where: str) -> None:
+    def check_spec_size(self, spec: Mapping[str, Any], where: str) -> None:
         """Refuse a generated map above the cell limit before generating it."""
-        rnd = spec.get("random")
-        if isinstance(rnd, Mapping):
-            size, res = rnd.get("size"), rnd.get("resolution", 1.0)
-            try:
-                w = math.ceil(float(size[0]) / float(res))  # type: ignore[index]
-                h = math.ceil(float(size[1]) / float(res))  # type: ignore[index]
-            except (TypeError, ValueError, IndexError, ZeroDivisionError, OverflowError):
-                return  # map_from_spec names the bad value
-            if w > 0 and h > 0:
-                _cells_ok(w, h, self.limits, f"{where}.random")
-        rows = spec.get("rows")
-        if isinstance(rows, list) and rows and isinstance(rows[0], str):
-            _cells_ok(len(rows[0]), len(rows), self.limits, f"{where}.rows")
+        from pathfuse.web.files import check_spec_cells
+
+        check_spec_cells(spec, self.limits, where)
 
     def _blank(self, d: Any, where: str) -> GridMap:
         from pathfuse import validate
@@ -364,17 +376,59 @@ class MapStore:
         return g
 
 
+def request_source(spec: Mapping[str, Any], where: str = "map") -> str:
+    """The one source key of a request's map mapping, checked against the allow-list
+    :data:`REQUEST_SOURCES` (the value is never shown: the answer is the same whether or
+    not a file of that name exists).
+
+    >>> request_source({"rows": ["..."], "resolution": 0.5})
+    'rows'
+    >>> request_source({"gazebo": "/etc/passwd"})  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pathfuse.web.limits.ApiError: map.gazebo: the server reads no file a request names; ...
+    """
+    from pathfuse.io.load import SPEC_SOURCES
+
+    sources = [k for k in spec if k in REQUEST_SOURCES]
+    for k in spec:
+        if k in REQUEST_SOURCES or (len(sources) == 1 and k in _COMPANIONS[sources[0]]):
+            continue
+        key = k if isinstance(k, str) else _short(k)
+        if k in SPEC_SOURCES:
+            raise ApiError(400, f"{where}.{key}: the server reads no file a request names; "
+                                "upload the map (POST /api/maps) and use its id")
+        allowed = ", ".join(_COMPANIONS[sources[0]]) if len(sources) == 1 else ""
+        raise ConfigError(f"{where}.{key}: unknown key (a map is one of "
+                          f"{', '.join(REQUEST_SOURCES)}"
+                          + (f"; allowed with '{sources[0]}': {allowed})" if allowed else ")"))
+    if len(sources) != 1:
+        what = "none" if not sources else ", ".join(sources)
+        raise ConfigError(f"{where}: needs exactly one of {', '.join(REQUEST_SOURCES)}; "
+                          f"it has {what}")
+    return sources[0]
+
+
 def _short(v: Any) -> str:
     from pathfuse.validate import short
 
     return short(v)
 
 
-def _loads(p: Path) -> bool:
-    """Whether a scenario file loads (the catalog lists only those)."""
+def _hide(message: str, path: Path, label: str) -> str:
+    """``message`` with the server's path of a file replaced by its catalog id."""
+    for p in (str(path), str(path.resolve())):
+        message = message.replace(p, label)
+    return message
+
+
+def _loads(p: Path, limits: Limits) -> bool:
+    """Whether a scenario file loads within the cell limit (the catalog lists only those)."""
+    from pathfuse.web.files import check_scenario_cells
     from pathfuse.world.scenario import load_scenario
 
     try:
+        check_scenario_cells(p, limits)
         load_scenario(p)
     except (PathfuseError, OSError, ValueError):
         return False
@@ -398,173 +452,3 @@ def _yaml_kind(p: Path) -> str:
     if "image" in doc or "rows" in doc:
         return "map"
     return ""
-
-
-# --------------------------------------------------------------------------- uploads
-_IMAGE = (".png", ".pgm", ".jpg", ".jpeg", ".bmp")
-
-
-def _check_header(path: Path, limits: Limits) -> None:
-    """Refuse a file whose header announces more cells than the limit (nothing decoded)."""
-    suffix = path.suffix.lower()
-    name = path.name
-    if suffix in _IMAGE:
-        from PIL import Image, UnidentifiedImageError
-
-        try:
-            with Image.open(path) as im:
-                w, h = im.size
-        except (UnidentifiedImageError, OSError, ValueError) as exc:
-            raise MapFormatError(f"{name}: not a readable image ({exc})") from None
-        _cells_ok(w, h, limits, name)
-    elif suffix == ".npy":
-        try:
-            arr = np.load(path, mmap_mode="r", allow_pickle=False)
-        except (OSError, ValueError) as exc:
-            raise MapFormatError(f"{name}: not a readable .npy array ({exc})") from None
-        shape = tuple(int(s) for s in getattr(arr, "shape", ()))
-        del arr
-        if len(shape) == 2:
-            _cells_ok(shape[1], shape[0], limits, name)
-    elif suffix == ".map":
-        try:
-            with path.open("rb") as f:
-                head = f.read(256).decode("ascii", "replace").split()
-        except OSError as exc:
-            raise MapFormatError(f"{name}: cannot read ({exc})") from None
-        dims = {}
-        for key in ("height", "width"):
-            if key in head:
-                i = head.index(key)
-                if i + 1 < len(head) and head[i + 1].isdigit():
-                    dims[key] = int(head[i + 1])
-        if len(dims) == 2:
-            _cells_ok(dims["width"], dims["height"], limits, name)
-
-
-def _safe_name(name: str, index: int) -> str:
-    """A file name to write an upload under: the base name's letters, digits and ``._-``."""
-    base = os.path.basename(str(name).replace("\\", "/")) or f"upload{index}"
-    keep = "".join(ch if ch.isalnum() or ch in "._-" else "_" for ch in base)[:100]
-    keep = keep.lstrip(".") or f"upload{index}"
-    return keep
-
-
-def _unzip(data: bytes, folder: Path, limits: Limits, zip_name: str) -> list[Path]:
-    try:
-        zf = zipfile.ZipFile(io.BytesIO(data))
-    except zipfile.BadZipFile:
-        raise MapFormatError(f"{zip_name}: not a valid zip file") from None
-    members = [m for m in zf.infolist() if not m.is_dir()]
-    if len(members) > 16:
-        raise ApiError(413, f"{zip_name}: {len(members)} files; a map zip holds at most 16")
-    total = sum(m.file_size for m in members)
-    if total > limits.max_upload_bytes * 4:
-        raise ApiError(413, f"{zip_name}: unpacks to {total} bytes, more than this server's "
-                            f"limit of {limits.max_upload_bytes * 4}")
-    out = []
-    for i, m in enumerate(members):
-        name = _safe_name(m.filename, i)
-        if name.startswith("__MACOSX") or m.filename.startswith("__MACOSX/"):
-            continue
-        target = folder / name
-        with zf.open(m) as src:
-            blob = src.read(m.file_size + 1)
-        if len(blob) > m.file_size:
-            raise MapFormatError(f"{zip_name}: {m.filename}: size does not match the zip's "
-                                 "directory")
-        target.write_bytes(blob)
-        out.append(target)
-    return out
-
-
-def _pick_map_file(paths: list[Path]) -> Path:
-    """The map among uploaded files: a YAML (ROS or rows) first, else the one map file."""
-    from pathfuse.io.load import SUPPORTED_SUFFIXES
-
-    yamls = [p for p in paths if p.suffix.lower() in (".yaml", ".yml")]
-    if len(yamls) > 1:
-        raise MapFormatError("several YAML files uploaded; upload one map at a time "
-                             f"({', '.join(p.name for p in yamls)})")
-    if yamls:
-        return yamls[0]
-    maps = [p for p in paths if p.suffix.lower() in SUPPORTED_SUFFIXES]
-    if len(maps) != 1:
-        names = ", ".join(p.name for p in paths) or "nothing"
-        raise MapFormatError(
-            f"expected one map file ({', '.join(SUPPORTED_SUFFIXES)}, or a ROS .yaml with its "
-            f"image, or a .zip of them), got {names}")
-    return maps[0]
-
-
-def _check_ros_image(yaml_path: Path, folder: Path) -> None:
-    """A ROS YAML's ``image`` must be one of the uploaded files (never a server path)."""
-    import yaml
-
-    try:
-        doc = yaml.safe_load(yaml_path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError):
-        return  # load_map names the problem
-    if not isinstance(doc, Mapping) or "image" not in doc:
-        return
-    img = doc.get("image")
-    if not isinstance(img, str):
-        return
-    target = (folder / img).resolve()
-    if target.parent != folder.resolve() or not target.is_file():
-        raise MapFormatError(
-            f"{yaml_path.name}: image {img!r} was not uploaded with it; upload the YAML and "
-            "its image together (two files, or one .zip)")
-
-
-def read_upload(files: list[tuple[str, bytes]], limits: Limits,
-                resolution: float | None = None) -> GridMap:
-    """Read uploaded files (name, content) into a map with :func:`pathfuse.load_map`.
-
-    One map file, a ROS YAML with its image, or a ``.zip`` of them.  Images and
-    ``.npy`` need ``resolution``.  Sizes and cell counts are checked first.
-    """
-    if not files:
-        raise MapFormatError("no file uploaded")
-    if len(files) > 4:
-        raise ApiError(400, f"{len(files)} files uploaded; a map is at most a YAML and its "
-                            "image (or one .zip)")
-    with tempfile.TemporaryDirectory(prefix="pathfuse-upload-") as tmp:
-        folder = Path(tmp)
-        try:
-            grid, name = _read_files(files, folder, limits, resolution)
-        except ApiError:
-            raise
-        except PathfuseError as exc:
-            # the temporary folder is the server's business: name the files as uploaded
-            raise type(exc)(str(exc).replace(str(folder) + os.sep, "")
-                            .replace(str(folder), "")) from None
-        except (ValueError, OSError, MemoryError) as exc:
-            msg = str(exc).replace(str(folder) + os.sep, "").replace(str(folder), "")
-            raise MapFormatError(f"cannot read this map ({msg})") from None
-    _cells_ok(grid.width, grid.height, limits, name)
-    return grid
-
-
-def _read_files(files: list[tuple[str, bytes]], folder: Path, limits: Limits,
-                resolution: float | None) -> tuple[GridMap, str]:
-    from pathfuse.io import load_map
-
-    paths: list[Path] = []
-    for i, (name, data) in enumerate(files):
-        safe = _safe_name(name, i)
-        if safe.lower().endswith(".zip"):
-            paths += _unzip(data, folder, limits, safe)
-        else:
-            target = folder / safe
-            target.write_bytes(data)
-            paths.append(target)
-    path = _pick_map_file(paths)
-    for p in paths:
-        _check_header(p, limits)
-    if path.suffix.lower() in (".yaml", ".yml"):
-        _check_ros_image(path, folder)
-    kwargs: dict[str, Any] = {}
-    if resolution is not None and path.suffix.lower() not in (".yaml", ".yml"):
-        kwargs["resolution"] = resolution
-    return load_map(path, **kwargs), path.name

@@ -18,13 +18,58 @@ from pathfuse import validate
 from pathfuse.result import Budget, ConfigError
 from pathfuse.web.maps import ApiError, Limits, MapStore, grid_to_json, pack_mask
 
-__all__ = ["planners_json", "plan_request", "field_request", "map_request", "LAYERS"]
+__all__ = ["planners_json", "plan_request", "field_request", "map_request", "parse_body",
+           "LAYERS"]
 
 LAYERS = ("closed", "cspace", "attractors")
 """Layers ``POST /api/plan`` can add under ``extras``."""
 
 _PLAN_KEYS = ("map", "seed", "start", "goal", "planner", "params", "robot_radius",
               "time_limit", "extras", "layers")
+
+
+def parse_body(raw: bytes, max_depth: int = 32) -> Any:
+    """A JSON request body: UTF-8, standard JSON (no ``NaN``), nested at most ``max_depth``
+    levels of objects and lists.
+
+    Raises
+    ------
+    ApiError
+        400 naming what is wrong.
+
+    >>> parse_body(b'{"map": "paper"}')
+    {'map': 'paper'}
+    >>> parse_body(b"[" * 40 + b"]" * 40)
+    Traceback (most recent call last):
+    ...
+    pathfuse.web.limits.ApiError: request body: JSON nested deeper than 32 levels
+    """
+    import json
+
+    def no_constant(name: str) -> Any:
+        raise ValueError(f"{name} is not JSON")
+
+    too_deep = ApiError(400, f"request body: JSON nested deeper than {max_depth} levels")
+    try:
+        doc = json.loads(raw.decode("utf-8"), parse_constant=no_constant)
+    except RecursionError:
+        raise too_deep from None
+    except UnicodeDecodeError as exc:
+        raise ApiError(400, f"request body: not valid JSON (not UTF-8 at byte {exc.start})"
+                       ) from None
+    except ValueError as exc:
+        raise ApiError(400, f"request body: not valid JSON ({exc})") from None
+    stack: list[tuple[Any, int]] = [(doc, 1)]
+    while stack:
+        node, depth = stack.pop()
+        children = node.values() if isinstance(node, dict) else node \
+            if isinstance(node, list) else ()
+        for child in children:
+            if isinstance(child, (dict, list)):
+                if depth + 1 > max_depth:
+                    raise too_deep
+                stack.append((child, depth + 1))
+    return doc
 
 
 def planners_json() -> list[dict[str, Any]]:

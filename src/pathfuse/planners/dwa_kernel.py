@@ -30,6 +30,8 @@ __all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "N_D"]
  D_GREF) = range(32)
 N_D = 32
 SOFT = 0.3
+KEEP_FLOOR = 0.02
+"""The keep critic's shortfall is relative to the path's gap, but to at least this (m)."""
 PASSIVE_COST = 20.0
 
 
@@ -298,7 +300,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
         want = min(f[D_GREF], f[D_KEEP])
         short = want - (dnear - radius)
         if short > 0.0 and want > 0.0:
-            out[0] += wkeep * (short / f[D_KEEP]) ** 2
+            out[0] += wkeep * min((short / max(want, KEEP_FLOOR)) ** 2, 1.0)
 
 
 @njit(cache=True, inline="always")

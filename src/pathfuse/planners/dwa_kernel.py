@@ -291,7 +291,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
               + f[D_WSPEED] * (f[D_VMAX] - v) / f[D_VMAX] + f[D_WOBS] * obs + f[D_WDYN] * dyn)
     if n_align > 0:
         out[0] += walign * align / n_align
-    wkeep = f[D_WKEEP]
+    wkeep = f[D_WKEEP] if n_disc == 0 else 0.0
     if wkeep > 0.0:
         # ours: keep the gap the global path keeps ahead (up to keep_m): the shortfall of
         # the least gap over the first obstacle_horizon_s, squared, relative to keep_m; a

@@ -32,7 +32,8 @@ then every control period:
    ``obstacle_range_m``, as Nav2's inflation layer, plus a steep penalty
    inside the robot's ``clearance_m``), *keep* (ours: the shortfall of the
    rollout's least gap over its first ``keep_horizon_s`` against the gap the
-   global path keeps over that stretch ahead, up to ``keep_m``, squared) and
+   global path keeps over that stretch ahead, up to ``keep_m``, relative to
+   that gap, squared; off while a moving disc is sensed) and
    *moving* (a predicted
    collision with a sensed disc: 1.5 + 2 x its depth relative to the two radii + 0.5 x how
    early it starts within the horizon, so that a swerve that makes the overlap shallower

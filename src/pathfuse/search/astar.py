@@ -323,6 +323,43 @@ class AStarSearcher:
         stamp = self._stamp.reshape(h + 2, w + 2)[1:-1, 1:-1]
         return stamp == self._closed_gen
 
+    def expansion_order(self, goal_cell: tuple[int, int],
+                        heuristic: str = "euclidean") -> np.ndarray:
+        """The cells of :meth:`closed_mask` in the order the last search expanded them, as
+        row-major indices ``row * W + col`` (int64).
+
+        The kernel pops nodes in non-decreasing ``f = g + h`` (``h`` consistent, so ``g`` is
+        final once a node is closed), so sorting the closed cells by their ``f``, recomputed
+        from the stored ``g`` as the kernel computes it, gives its order; among equal ``f``
+        (to 1e-9 cell, so that rounding does not split a tie) the lower ``g`` comes first
+        (the goal, which ends the search, is last).  The kernel breaks such ties its own
+        way, so cells of equal ``f`` may be permuted.  For looking inside a search
+        (``pathfuse serve`` animates it); nothing on the search path computes it.
+        ``goal_cell`` and ``heuristic`` must be those of the last search.
+
+        >>> occ = np.zeros((3, 4), dtype=bool)
+        >>> s = AStarSearcher(occ)
+        >>> r = s.search((0, 0), (0, 3))
+        >>> order = s.expansion_order((0, 3))
+        >>> int(order[0]), int(order[-1]), len(order) == r.expansions
+        (0, 3, True)
+        """
+        h, w = self.shape
+        mask = self.closed_mask()
+        idx = np.flatnonzero(mask)
+        if idx.size == 0:
+            return idx.astype(np.int64)
+        g = self._g.reshape(h + 2, w + 2)[1:-1, 1:-1].ravel()[idx]
+        dy = np.abs(idx // w - int(goal_cell[0]))
+        dx = np.abs(idx % w - int(goal_cell[1]))
+        if heuristic == "octile":
+            hv = np.where(dx > dy, dx + (1.4142135623730951 - 1.0) * dy,
+                          dy + (1.4142135623730951 - 1.0) * dx)
+        else:
+            hv = np.sqrt((dx * dx + dy * dy).astype(np.float64))
+        # f rounded to 1e-9 cell: sums that tie exactly tie here too, whatever the rounding
+        return idx[np.lexsort((idx, g, np.round(g + hv, 9)))].astype(np.int64)
+
 
 # ----------------------------------------------------------------------------- cache
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

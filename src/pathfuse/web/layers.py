@@ -10,7 +10,8 @@ plan, on request.
   on a coarser lattice for arrows.
 * :func:`closed_set` runs the planner's global A* again on a fresh searcher
   (the same c-space, heuristic and corner rule; A* is deterministic, so the
-  same search) and reads the cells it closed.
+  same search) and reads the cells it closed; :func:`closed_order` also gives
+  them in expansion order, for the page's animated search.
 * :func:`attractors` walks the returned path and, at each of its points,
   lists the A* waypoints that attract the robot there: inside the circle of
   radius ``r1_m`` and ahead (past the progress index, replayed with
@@ -31,12 +32,17 @@ from pathfuse.field.repulsion import apf_force
 from pathfuse.grid import GridMap
 from pathfuse.problem import Problem
 
-__all__ = ["potential_field", "closed_set", "attractors", "f32"]
+__all__ = ["potential_field", "closed_set", "closed_order", "attractors", "f32", "i32"]
 
 
 def f32(a: np.ndarray) -> str:
     """base64 of a float32 array (row-major; NaN stays NaN)."""
     return base64.b64encode(np.ascontiguousarray(a, dtype="<f4").tobytes()).decode("ascii")
+
+
+def i32(a: np.ndarray) -> str:
+    """base64 of a little-endian int32 array (row-major)."""
+    return base64.b64encode(np.ascontiguousarray(a, dtype="<i4").tobytes()).decode("ascii")
 
 
 @njit(cache=True, nogil=True)
@@ -155,6 +161,16 @@ def closed_set(problem: Problem, heuristic: str = "euclidean",
                ) -> np.ndarray | None:
     """The cells the planner's global A* closes for ``problem`` ((H, W) bool), or None when
     the problem fails before any search (a blocked or outside start or goal)."""
+    got = closed_order(problem, heuristic, corner_cutting, time_limit_s)
+    return None if got is None else got[0]
+
+
+def closed_order(problem: Problem, heuristic: str = "euclidean",
+                 corner_cutting: bool = False, time_limit_s: float | None = None
+                 ) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`closed_set` and the same cells in the order the search expanded them
+    (row-major indices, :meth:`~pathfuse.search.astar.AStarSearcher.expansion_order`), or
+    None when the problem fails before any search."""
     from pathfuse.planners.global_astar import snap_cell
     from pathfuse.search.astar import AStarSearcher
 
@@ -173,7 +189,7 @@ def closed_set(problem: Problem, heuristic: str = "euclidean",
     labels = None if corner_cutting else cs.components
     searcher = AStarSearcher(cs.occupied, corner_cutting=corner_cutting, labels=labels)
     searcher.search_checked(sc, gc, heuristic, None, time_limit_s)
-    return searcher.closed_mask()
+    return searcher.closed_mask(), searcher.expansion_order(gc, heuristic)
 
 
 def attractors(problem: Problem, path: np.ndarray, waypoints: np.ndarray, r1_m: float,

@@ -176,7 +176,8 @@ def plan_request(store: MapStore, body: Any, limits: Limits) -> dict[str, Any]:
     With ``"extras": true`` it adds ``extras``: the independent metrics of
     :func:`pathfuse.metrics.evaluate` (minimum clearance, collision-free),
     the A* path of the hybrids, and the layers asked for in ``layers``
-    (``closed``: the A* closed set as packed bits; ``cspace``: the inflated
+    (``closed``: the A* closed set as packed bits, and its cells in expansion order as
+    base64 int32 row-major indices; ``cspace``: the inflated
     map; ``attractors``: per path point, the A* waypoints attracting there).
     """
     from pathfuse.planners.registry import get_planner, make_params
@@ -221,11 +222,12 @@ def plan_request(store: MapStore, body: Any, limits: Limits) -> dict[str, Any]:
     heuristic = getattr(cfg, "heuristic", "euclidean")
     cutting = bool(getattr(cfg, "corner_cutting", False))
     if "closed" in layers and spec.uses_astar:
-        from pathfuse.web.layers import closed_set
+        from pathfuse.web.layers import closed_order, i32
 
-        mask = closed_set(problem, heuristic, cutting, limit)
-        ex["closed"] = None if mask is None else {"bits": pack_mask(mask),
-                                                  "count": int(mask.sum())}
+        got = closed_order(problem, heuristic, cutting, limit)
+        ex["closed"] = None if got is None else {"bits": pack_mask(got[0]),
+                                                 "count": int(got[0].sum()),
+                                                 "order": i32(got[1])}
     if "cspace" in layers:
         ex["cspace"] = {"bits": pack_mask(grid.cspace(radius).occupied),
                         "robot_radius": radius}

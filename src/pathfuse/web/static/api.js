@@ -6,7 +6,10 @@ export class ApiError extends Error {
 
 async function answer(resp) {
   let data = null;
-  try { data = await resp.json(); } catch (e) { data = null; }
+  try { data = await resp.json(); } catch (e) {
+    if (isAbort(e)) throw e;  // aborted while the body was read
+    if (resp.ok) throw new ApiError(resp.status, `HTTP ${resp.status}: the answer is not JSON`);
+  }
   if (!resp.ok) {
     const msg = data && data.error ? data.error : `HTTP ${resp.status}`;
     throw new ApiError(resp.status, msg);
@@ -14,15 +17,19 @@ async function answer(resp) {
   return data;
 }
 
-export async function getJSON(url) {
-  return answer(await fetch(url));
+export async function getJSON(url, { signal } = {}) {
+  return answer(await fetch(url, { signal }));
 }
 
-export async function postJSON(url, body) {
+// signal: an AbortSignal; aborting it cancels the request (the server then stops its work)
+export async function postJSON(url, body, { signal } = {}) {
   return answer(await fetch(url, {
     method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body),
+    signal,
   }));
 }
+
+export function isAbort(e) { return e && e.name === "AbortError"; }
 
 export async function postFiles(url, files, fields = {}) {
   const form = new FormData();
@@ -53,10 +60,19 @@ export function packBits(cells) {
   return btoa(s);
 }
 
-export function float32s(b64) {
+function bytesOf(b64) {
   const bin = atob(b64);
-  const buf = new ArrayBuffer(bin.length);
-  const u8 = new Uint8Array(buf);
+  const u8 = new Uint8Array(bin.length);
   for (let i = 0; i < bin.length; i++) u8[i] = bin.charCodeAt(i);
-  return new Float32Array(buf);
+  return u8;
+}
+
+export function float32s(b64) { return new Float32Array(bytesOf(b64).buffer); }
+
+// base64 of little-endian int32 (the closed set's expansion order)
+export function int32s(b64) {
+  const u8 = bytesOf(b64);
+  const dv = new DataView(u8.buffer), out = new Int32Array(u8.length >> 2);
+  for (let i = 0; i < out.length; i++) out[i] = dv.getInt32(4 * i, true);
+  return out;
 }

@@ -8,11 +8,30 @@ export class Scene {
     this.extra = {};       // the other scenario keys of a loaded scenario (seed, stall_time, ...)
     this.name = "playground";
     this.onChange = onChange;
+    this.check = () => "";  // (spec, i) -> "" or why the disc cannot be there (set by the page)
+    this.onError = () => {};
+    this.beforeChange = () => {};  // called before every change (the page's undo)
   }
 
-  add(spec) { this.obstacles.push(spec); this.onChange(); }
-  remove(i) { this.obstacles.splice(i, 1); this.onChange(); }
-  clear() { this.obstacles = []; this.onChange(); }
+  add(spec) {
+    const why = this.check(spec, this.obstacles.length);
+    if (why) { this.onError(why); return false; }
+    this.beforeChange();
+    this.obstacles.push(spec); this.onChange(); return true;
+  }
+  remove(i) { this.beforeChange(); this.obstacles.splice(i, 1); this.onChange(); }
+  clear() {
+    if (!this.obstacles.length) return;
+    this.beforeChange(); this.obstacles = []; this.onChange();
+  }
+
+  // replace disc i by spec when it is valid there; returns "" or the reason it is not
+  replace(i, spec) {
+    const why = this.check(spec, i);
+    if (why) { this.onError(why); return why; }
+    this.beforeChange();
+    this.obstacles[i] = spec; this.onChange(); return "";
+  }
 
   // where each disc starts, and its velocity arrow when it has one
   starts() {
@@ -21,23 +40,72 @@ export class Scene {
       if (o.waypoints) return { p: o.waypoints[0], r: o.radius, way: o.waypoints };
       if (o.random_walk) return { p: o.random_walk.position, r: o.radius, walk: true };
       return null;
-    }).filter(Boolean);
+    });
   }
 
-  renderList(box) {
+  // the disc part under world point w (scale: pixels per metre): its velocity arrow's head,
+  // its rim or its inside, the topmost (last placed) first
+  hit(w, scale) {
+    const st = this.starts();
+    for (let i = st.length - 1; i >= 0; i--) {
+      const s = st[i];
+      if (!s) continue;
+      if (s.v) {
+        const hx = s.p[0] + s.v[0], hy = s.p[1] + s.v[1];
+        if (Math.hypot(w[0] - hx, w[1] - hy) * scale < 9) return { i, part: "head" };
+      }
+      const d = Math.hypot(w[0] - s.p[0], w[1] - s.p[1]);
+      if (Math.abs(d - s.r) * scale < 6 && s.r * scale >= 8) return { i, part: "rim" };
+      if (d < s.r || d * scale < 8) return { i, part: "centre" };
+    }
+    return null;
+  }
+
+  // a copy of disc spec o moved by (dx, dy), with radius r, velocity v (when given)
+  static edited(o, { dx = 0, dy = 0, r = null, v = null } = {}) {
+    const q = JSON.parse(JSON.stringify(o));
+    const mv = (p) => [round(p[0] + dx), round(p[1] + dy)];
+    if (q.position) q.position = mv(q.position);
+    if (q.waypoints) q.waypoints = q.waypoints.map(mv);
+    if (q.random_walk && q.random_walk.position) q.random_walk.position = mv(q.random_walk.position);
+    if (r != null) q.radius = round(r);
+    if (v != null && q.velocity) q.velocity = [round(v[0]), round(v[1])];
+    return q;
+  }
+
+  // problems: per disc, "" or why it cannot be where it is (after an edit of the map)
+  renderList(box, problems = []) {
     box.replaceChildren();
     this.obstacles.forEach((o, i) => {
       let text;
       const f = (v) => Number(v).toFixed(2);
-      if (o.position) text = `disc ${i}: (${f(o.position[0])}, ${f(o.position[1])}) v (${f(o.velocity[0])}, ${f(o.velocity[1])}) m/s r ${f(o.radius)} m`;
-      else if (o.waypoints) text = `disc ${i}: patrol of ${o.waypoints.length} points at ${f(o.speed)} m/s r ${f(o.radius)} m`;
-      else text = `disc ${i}: random walk at ${f(o.random_walk.speed)} m/s r ${f(o.radius)} m`;
-      const del = el("button", { text: "×", title: "remove this disc" });
+      const v = o.velocity || [0, 0];
+      if (o.position) text = `disc ${i}: (${f(o.position[0])}, ${f(o.position[1])}) v (${f(v[0])}, ${f(v[1])}) m/s`;
+      else if (o.waypoints) text = `disc ${i}: patrol of ${o.waypoints.length} points at ${f(o.speed)} m/s`;
+      else text = `disc ${i}: random walk at ${f(o.random_walk.speed)} m/s`;
+      const r = el("input", { type: "number", min: "0.01", step: "0.05", value: o.radius,
+                              title: "radius (m)", "aria-label": `disc ${i} radius` });
+      r.addEventListener("change", () => {
+        const raw = r.value, v = Number(raw);
+        if (!(v > 0)) {
+          this.onError(`obstacles[${i}].radius: must be a number > 0, got ${JSON.stringify(raw)}`);
+          r.value = o.radius;
+        } else if (this.replace(i, Scene.edited(o, { r: v }))) r.value = o.radius;
+      });
+      const del = el("button", { text: "×", title: "remove this disc", "aria-label": `remove disc ${i}` });
       del.addEventListener("click", () => this.remove(i));
-      box.append(el("div", { className: "disc" }, el("span", { text }), del));
+      const row = el("div", { className: "disc" }, el("span", { text }),
+        el("label", { className: "inline", text: "r " }, r), del);
+      if (problems[i]) {
+        row.classList.add("bad");
+        row.append(el("div", { className: "error small", text: problems[i] }));
+      }
+      box.append(row);
     });
   }
 }
+
+function round(v) { return Math.round(v * 1000) / 1000; }
 
 // playback of an episode (the answer of POST /api/simulate) at real time x speed
 export class Player {

@@ -2,8 +2,14 @@
 // one input per field, by kind (float, int, bool, choice, str), with its unit, bounds,
 // default and help text.  Nothing here knows any planner by name.
 
-export const PALETTE = ["#e4572e", "#2563eb", "#17a34a", "#9333ea", "#d97706", "#0891b2",
-  "#db2777", "#4d7c0f", "#7c3aed", "#0f766e", "#b45309", "#475569"];
+// One colour per planner, in the registry's order (astar, astar-replan, apf, fusion, ref6,
+// ref7, astar-smooth, thetastar, lazy-thetastar, shortest, dwa, mppi).  Chosen so that any two
+// differ by a CIEDE2000 distance of at least 12 for normal vision and for simulated
+// protanopia, deuteranopia and tritanopia (Machado et al. 2009, severity 1), with a contrast
+// of at least 2.2:1 on the white map; the browser test checks the colours the page shows.
+// A 13th planner (a plug-in) starts the colours again, drawn dashed.
+export const PALETTE = ["#00568F", "#74C200", "#33BBEE", "#DC1867", "#9B8427", "#8F0056",
+  "#5C5CFF", "#AE1313", "#27849B", "#777777", "#DE907C", "#0000F5"];
 
 function el(tag, attrs = {}, ...kids) {
   const e = document.createElement(tag);
@@ -93,6 +99,15 @@ export function plannerForm(planner, color, onChange) {
         if (!r.isDefault) out[p.name] = r.value;
       }
       return out;
+    },
+    // every field back to its default
+    reset() {
+      for (const p of planner.params) {
+        const inp = inputs.get(p.name);
+        if (inp.type === "checkbox") inp.checked = !!p.default;
+        else inp.value = p.default ?? "";
+        inp.classList.remove("bad");
+      }
     },
     set(values) {
       for (const [k, v] of Object.entries(values || {})) {

@@ -11,6 +11,7 @@ export class View {
     this.overlays = new Map();  // name -> {canvas, x0, y0, w, h, alpha}
     this.drawers = [];          // functions (ctx, view) drawing in world coordinates
     this.pending = false;
+    this.holding = false;  // set while the pointer drags something on the canvas
     this.onFrame = null;
     new ResizeObserver(() => this.resize()).observe(canvas);
     this.resize();
@@ -22,7 +23,8 @@ export class View {
     this.canvas.width = Math.max(1, Math.round(r.width * dpr));
     this.canvas.height = Math.max(1, Math.round(r.height * dpr));
     this.dpr = dpr;
-    if (this.fitted) this.fit(); else this.redraw();
+    // a drag in progress keeps the world where it is under the pointer
+    if (this.fitted && !this.holding) this.fit(); else this.redraw();
   }
 
   setMap(map) {

@@ -35,6 +35,9 @@ Usage::
 
     python benchmarks/bench_astar.py [--maps maze512-4-6 64room_005 Boston_0_1024]
         [--queries 60] [--seed 0] [--nx-queries 3] [--data DIR] [--json out.json]
+
+``--json`` writes ``{"machine", "load_end", "queries", "seed", "rows"}`` (a row per map,
+tool and corner rule), what ``benchmarks/run_all.py`` renders into the README.
 """
 
 from __future__ import annotations
@@ -348,14 +351,23 @@ def main(argv: list[str] | None = None) -> list[dict]:
         import tcod  # noqa: F401
     except ImportError:
         sys.exit("tcod is not installed: pip install 'pathfuse[bench]'")
+    import os
+    import platform
+
+    load0 = round(os.getloadavg()[0], 2)
     print(f"pathfuse {pathfuse.__version__}, numpy {np.__version__}, scipy {scipy.__version__}, "
-          f"tcod {__import__('tcod').__version__}, networkx {__import__('networkx').__version__}")
+          f"tcod {__import__('tcod').__version__}, networkx {__import__('networkx').__version__}; "
+          f"{platform.machine()}, {os.cpu_count()} cores, load average {load0}")
     rows = []
     for name in args.maps:
         rows += bench_map(name, args.data, args.queries, args.seed, args.nx_queries)
     print_table(rows)
     if args.json:
-        args.json.write_text(json.dumps(rows, indent=1))
+        out = {"machine": {"machine": platform.machine(), "cores": os.cpu_count(), "load": load0,
+                           "python": platform.python_version()},
+               "load_end": round(os.getloadavg()[0], 2), "queries": args.queries,
+               "seed": args.seed, "rows": rows}
+        args.json.write_text(json.dumps(out, indent=1))
     return rows
 
 

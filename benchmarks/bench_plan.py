@@ -15,7 +15,8 @@ rounds so that machine noise hits them alike:
 
 It prints the median microseconds per query, ``plan / kernel`` (the glue's
 share; 1.0 = none) and ``scipy / plan``, and a tiny query (two neighbouring
-cells of Boston_0_1024, 3 expansions) that exposes the fixed cost of a call.
+cells of Boston_0_1024: the start and the goal are expanded) that exposes the
+fixed cost of a call.
 numba compilation and the per-map buffers are made by a warm-up query before
 any timing.  Wall time and CPU time (``time.process_time``) are both printed,
 with the load average and the core count: the machines are shared.
@@ -23,12 +24,13 @@ with the load average and the core count: the machines are shared.
 Usage::
 
     python benchmarks/bench_plan.py [--data DIR] [--queries 100] [--seed 0] [--repeat 2000]
-        [--rounds 5]
+        [--rounds 5] [--json out.json]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import statistics
@@ -57,7 +59,7 @@ def timed(fn) -> tuple[float, float]:
     return time.perf_counter() - w0, time.process_time() - c0
 
 
-def tiny(data: Path, repeat: int) -> None:
+def tiny(data: Path, repeat: int) -> dict:
     g = read_movingai(data / "Boston_0_1024.map")
     free = np.argwhere(~g.occupied)
     r, c = (int(v) for v in free[len(free) // 2])
@@ -76,15 +78,20 @@ def tiny(data: Path, repeat: int) -> None:
         kern_w.append(w)
         kern_c.append(cpu)
     pw, kw = statistics.median(plan_w), statistics.median(kern_w)
-    print(f"tiny query on Boston_0_1024 ({repeat} calls): plan() {1e6 * pw:.1f} us "
-          f"(CPU {1e6 * statistics.median(plan_c):.1f}), kernel {1e6 * kw:.1f} us "
-          f"(CPU {1e6 * statistics.median(kern_c):.1f}); fixed overhead of plan() "
-          f"{1e6 * (pw - kw):.1f} us")
+    exp = searcher.search((r, c), nb).expansions
+    print(f"tiny query on Boston_0_1024 ({repeat} calls, {exp} expansions): plan() "
+          f"{1e6 * pw:.1f} us (CPU {1e6 * statistics.median(plan_c):.1f}), kernel "
+          f"{1e6 * kw:.1f} us (CPU {1e6 * statistics.median(kern_c):.1f}); fixed overhead "
+          f"of plan() {1e6 * (pw - kw):.1f} us")
+    return {"calls": repeat, "expansions": exp, "plan_us": 1e6 * pw, "kernel_us": 1e6 * kw,
+            "plan_cpu_us": 1e6 * statistics.median(plan_c),
+            "kernel_cpu_us": 1e6 * statistics.median(kern_c)}
 
 
-def per_map(data: Path, queries: int, seed: int, rounds: int) -> None:
+def per_map(data: Path, queries: int, seed: int, rounds: int) -> dict:
     print(f"\n{'map':<32} {'n':>4} {'plan us':>10} {'kernel us':>10} {'plan/kernel':>11} "
           f"{'scipy us':>10} {'scipy/plan':>10}")
+    out = {}
     for scen in sorted(data.glob("*.scen")):
         name = scen.name.split(".map")[0].split("-random-")[0]
         mp = data / f"{name}.map"
@@ -118,24 +125,35 @@ def per_map(data: Path, queries: int, seed: int, rounds: int) -> None:
         mp_, mk, ms = (statistics.median(v) for v in (tp, tk, ts))
         print(f"{name:<32} {len(pick):>4} {1e6 * mp_:>10.1f} {1e6 * mk:>10.1f} "
               f"{mp_ / mk:>11.2f} {1e6 * ms:>10.1f} {ms / mp_:>10.1f}")
+        out[name] = {"queries": len(pick), "plan_us": 1e6 * mp_, "kernel_us": 1e6 * mk,
+                     "scipy_us": 1e6 * ms}
+    return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
     ap.add_argument("--queries", type=int, default=100)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--repeat", type=int, default=2000)
     ap.add_argument("--rounds", type=int, default=5)
-    args = ap.parse_args()
+    ap.add_argument("--json", type=Path, help="write the numbers to this file")
+    args = ap.parse_args(argv)
     if not args.data.is_dir():
         sys.exit(f"no MovingAI data in {args.data} (pass --data)")
+    load0 = round(os.getloadavg()[0], 2)
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores, load average "
-          f"{os.getloadavg()[0]:.2f}; python {platform.python_version()}; "
+          f"{load0:.2f}; python {platform.python_version()}; "
           f"pathfuse from {Path(pathfuse.__file__).parent}")
-    tiny(args.data, args.repeat)
-    per_map(args.data, args.queries, args.seed, args.rounds)
-    print(f"\nload average at the end: {os.getloadavg()[0]:.2f}")
+    res = {"machine": {"machine": platform.machine(), "cores": os.cpu_count(), "load": load0,
+                       "python": platform.python_version()},
+           "tiny": tiny(args.data, args.repeat),
+           "maps": per_map(args.data, args.queries, args.seed, args.rounds)}
+    res["load_end"] = round(os.getloadavg()[0], 2)
+    print(f"\nload average at the end: {res['load_end']:.2f}")
+    if args.json:
+        args.json.write_text(json.dumps(res, indent=1) + "\n")
+    return res
 
 
 if __name__ == "__main__":

@@ -5,9 +5,10 @@ Measured as ratios within one run (nothing here is asserted by the tests):
 1. Paper maps (15 m x 15 m, 1 m cells, 50 obstacles, start (1,1), goal (11,11)):
    per seed, the planning time ``time_s`` of A* and of fusion (which includes
    its A*), each the minimum of ``--repeat`` alternating runs; reports the
-   median over seeds of fusion / A* (target: <= 2), and the same ratio for the
-   wall time of whole ``plan()`` calls (query checks and result building
-   included).
+   median over seeds of fusion / A* (the paper reports 1.56 in MATLAB; a
+   faster A* raises this ratio, as fusion's stepping is most of its time), and
+   the same ratio for the wall time of whole ``plan()`` calls (query checks and
+   result building included).
 2. Steps per second of the APF and fusion stepping loops (force steps divided
    by the time spent inside the stepping driver, numba dispatch included) on
    the paper maps and on a 1024 x 1024 map of the same obstacle density, for
@@ -24,6 +25,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import platform
 import statistics
 import sys
 import time
@@ -62,6 +65,7 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--repeat", type=int, default=5, help="timing repeats (min is kept)")
     ap.add_argument("--json", help="write the numbers to this file")
     args = ap.parse_args(argv)
+    load0 = round(os.getloadavg()[0], 2)
 
     for name in ("astar", "apf", "fusion"):
         warm(get_planner(name))  # compile (or load) the kernels before any clock starts
@@ -121,6 +125,9 @@ def main(argv: list[str] | None = None) -> dict:
         long_run = plan(big, far[0], far[1], planner="fusion")
 
     out = {
+        "machine": {"machine": platform.machine(), "cores": os.cpu_count(), "load": load0,
+                    "python": platform.python_version()},
+        "load_end": round(os.getloadavg()[0], 2),
         "paper_seeds": args.seeds,
         "fusion_success": fus_ok,
         "astar_time_median_s": statistics.median(t_astar),
@@ -153,7 +160,7 @@ def main(argv: list[str] | None = None) -> dict:
     print(f"  A* median {out['astar_time_median_s'] * 1e6:9.1f} us   "
           f"fusion median {out['fusion_time_median_s'] * 1e6:9.1f} us")
     print(f"  fusion / A* time_s: median {out['fusion_over_astar_median']:.2f}  "
-          f"p90 {out['fusion_over_astar_p90']:.2f}   (target median <= 2)")
+          f"p90 {out['fusion_over_astar_p90']:.2f}   (the paper: 1.56 in MATLAB)")
     print(f"  fusion / A* wall time of the whole plan() call: median "
           f"{out['fusion_over_astar_wall_median']:.2f}")
     print("steps per second (stepping driver, dispatch included):")

@@ -13,8 +13,10 @@ __all__ = ["add_barn_parser", "cmd_barn"]
 
 def add_barn_parser(sub: Any) -> None:
     """Register the ``barn`` sub-command on the parser's sub-parsers."""
-    from pathfuse.studies.barn import JACKAL_MAX_SPEED_M_S, JACKAL_RADIUS_M
-
+    # the Jackal's radius and speed of pathfuse.studies.barn, written out: importing that
+    # module here would load numpy for every `pathfuse --help` (tests/test_cli_startup.py
+    # checks that they agree)
+    radius, speed = 0.333, 2.0
     b: _Parser = sub.add_parser(
         "barn",
         help="run the BARN challenge's protocol on its Gazebo worlds",
@@ -54,10 +56,10 @@ examples:
                    help="the robot's kinematics (default diff-drive: a Jackal-like base; "
                    "holonomic: pathfuse's point robot that changes velocity at once)")
     b.add_argument("--robot-radius", type=_positive_float, default=None,
-                   help=f"radius of the disc robot, m (default {JACKAL_RADIUS_M}: the "
+                   help=f"radius of the disc robot, m (default {radius:g}: the "
                    "Jackal's body fits in it at any heading)")
     b.add_argument("--max-speed", type=_positive_float, default=None,
-                   help=f"speed limit, m/s (default {JACKAL_MAX_SPEED_M_S:g}, the Jackal's)")
+                   help=f"speed limit, m/s (default {speed:g}, the Jackal's)")
     b.add_argument("--dt", type=_positive_float, default=None,
                    help="simulation tick, s (default 0.1)")
     b.add_argument("--param", action="append", metavar="PLANNER.KEY=VALUE",

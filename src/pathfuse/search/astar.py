@@ -47,7 +47,12 @@ Implementation
 * Start and goal in different connected free regions answer ``NO_PATH``
   without searching (``GridMap.components``, 4-connected labels, which equal
   8-connected reachability without corner cutting; 8-connected labels are
-  computed for the corner-cutting rule).
+  computed for the corner-cutting rule).  On a map of more than
+  ``_EAGER_LABELS`` cells (2**21) the labels are made only when a search
+  first exhausts its region: labelling 4096 x 4096 cells costs about half a
+  second, which the first query on a new map would otherwise pay even though
+  most queries have a path; until then a query between two regions answers
+  ``NO_PATH`` after searching the start's region.
 * The kernel runs in chunks of expansions; between chunks the wall clock is
   checked, which bounds the time a query can overrun its limit.
 
@@ -75,6 +80,7 @@ import numpy as np
 
 from pathfuse.result import ConfigError, MapError, QueryError, Status
 from pathfuse.search.kernel import (
+    _BLOCKED,
     _CHUNK,
     _EXHAUSTED,
     _FOUND,
@@ -99,6 +105,7 @@ SQRT2 = math.sqrt(2.0)
 HEURISTICS = ("euclidean", "octile")
 """Accepted heuristic names."""
 
+_EAGER_LABELS = 1 << 21  # maps of more cells label their regions on first need
 _NO_CELLS = np.zeros((0, 2), dtype=np.int64)
 _NO_CELLS.setflags(write=False)
 _NO_POINTS = np.zeros((0, 2))
@@ -134,7 +141,35 @@ class SearchResult:
     points: np.ndarray = field(default_factory=lambda: _NO_POINTS)
 
 
-class AStarSearcher:
+class _Regions:
+    """The connected-region labels of a searcher's free cells, made eagerly on a small map
+    and on first need (a search that exhausted its region) on a large one."""
+
+    corner_cutting: bool
+
+    def _init_labels(self, occ: np.ndarray, labels: np.ndarray | None) -> None:
+        self._occ = occ
+        self._grid: weakref.ref | None = None  # a GridMap whose cached labels to use
+        self._labels: np.ndarray | None = None
+        if labels is not None:
+            self._labels = np.asarray(labels)
+        elif occ.size <= _EAGER_LABELS:
+            self._labels = self._make_labels()
+
+    def _make_labels(self) -> np.ndarray:
+        """The component labels of the free cells under this searcher's corner rule (the
+        map's cached ``components`` when the searcher came from the per-map cache)."""
+        grid = self._grid() if self._grid is not None else None
+        if grid is not None and not self.corner_cutting:
+            return np.asarray(grid.components)
+        from scipy import ndimage
+
+        structure = np.ones((3, 3), dtype=bool) if self.corner_cutting else None
+        labels, _ = ndimage.label(~self._occ, structure=structure)
+        return np.asarray(labels)
+
+
+class AStarSearcher(_Regions):
     """A* on one occupancy grid, with buffers kept between queries.
 
     Parameters
@@ -146,7 +181,8 @@ class AStarSearcher:
         Allow a diagonal move past a blocked orthogonal neighbour.
     labels : ndarray of int, optional
         Connected-component labels of the free cells under this corner rule
-        (0 on blocked cells); computed when not given.
+        (0 on blocked cells); computed when not given (on a map of more than
+        ``_EAGER_LABELS`` cells, only once a search has exhausted a region).
 
     Notes
     -----
@@ -167,13 +203,11 @@ class AStarSearcher:
         self.corner_cutting = bool(corner_cutting)
         h, w = self.shape
         self._wp = w + 2
-        free = np.zeros((h + 2, w + 2), dtype=np.uint8)
-        free[1:-1, 1:-1] = ~occ
-        self._free = free.ravel()
-        n = self._free.size
+        cell = np.full((h + 2, w + 2), _BLOCKED, dtype=np.uint32)
+        np.multiply(occ, _BLOCKED, out=cell[1:-1, 1:-1], dtype=np.uint32)  # 3x a mask
+        self._cell = cell.ravel()  # blocked / stamp and move: see kernel._astar_kernel
+        n = self._cell.size
         self._g = np.empty(n, dtype=np.float64)
-        self._stamp = np.zeros(n, dtype=np.int32)
-        self._parent = np.zeros(n, dtype=np.uint8)
         cap = int(min(max(1024, n // 4), 1 << 20))
         self._qkey = np.empty(cap, dtype=np.uint64)
         self._qnode = np.empty(cap, dtype=np.int32)
@@ -185,13 +219,8 @@ class AStarSearcher:
         self._meta = np.zeros(5, dtype=np.int64)
         self._gen = 0
         self._closed_gen = -1  # stamp of the cells the last search closed (-1: none)
-        self.free_count = int(n - (self._free == 0).sum())
-        if labels is None:
-            structure = np.ones((3, 3), dtype=bool) if self.corner_cutting else None
-            from scipy import ndimage
-
-            labels, _ = ndimage.label(~occ, structure=structure)
-        self._labels = np.asarray(labels)
+        self.free_count = int(occ.size - np.count_nonzero(occ))
+        self._init_labels(occ, labels)
         self.lock = threading.Lock()
 
     def _grow_heap(self) -> None:
@@ -237,7 +266,7 @@ class AStarSearcher:
         for what, r, c in (("start", sr, sc), ("goal", gr, gc)):
             if not (0 <= r < h and 0 <= c < w):
                 raise QueryError(f"{what} cell ({r}, {c}) is outside the {h}x{w} grid")
-            if not self._free[(r + 1) * self._wp + c + 1]:
+            if self._cell[(r + 1) * self._wp + c + 1] == _BLOCKED:
                 raise QueryError(f"{what} cell ({r}, {c}) is occupied")
         with self.lock:
             return self._search(sr, sc, gr, gc, heuristic, max_expansions, time_limit_s,
@@ -262,7 +291,8 @@ class AStarSearcher:
             ox, oy, res = origin
             return SearchResult(Status.SUCCESS, np.array([[sr, sc]], dtype=np.int64), 0.0, 0,
                                 np.array([[ox + (sc + 0.5) * res, oy + (sr + 0.5) * res]]))
-        if self._labels[sr, sc] != self._labels[gr, gc]:
+        labels = self._labels
+        if labels is not None and labels[sr, sc] != labels[gr, gc]:
             return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, 0)
         # a search never expands more than the free cells: a larger budget (even 10**30)
         # means no cap, and stays within the kernel's 64-bit integers
@@ -272,7 +302,7 @@ class AStarSearcher:
         start = (sr + 1) * wp + sc + 1
         goal = (gr + 1) * wp + gc + 1
         if self._gen >= _STAMP_LIMIT:
-            self._stamp[:] = 0
+            self._cell[self._cell != _BLOCKED] = 0
             self._gen = 0
         self._gen += 2
         gen = self._gen
@@ -284,16 +314,18 @@ class AStarSearcher:
         while True:
             step = min(chunk, budget - done)
             code, n = _astar_kernel(
-                self._free, self._g, self._stamp, self._parent, self._qkey, self._qnode,
-                self._qnext, self._heads, self._bits, self._skey, self._snode, self._meta,
-                gen, first, goal, wp, octile, self.corner_cutting, not octile, step,
+                self._cell, self._g, self._qkey, self._qnode, self._qnext, self._heads,
+                self._bits, self._skey, self._snode, self._meta, gen, first, goal, wp,
+                octile, self.corner_cutting, not octile, step,
             )
             first = -1
             done += n
             if code == _FOUND:
-                cells, pts = _trace(self._parent, start, goal, wp, *origin)
+                cells, pts = _trace(self._cell, start, goal, wp, *origin)
                 return SearchResult(Status.SUCCESS, cells, float(self._g[goal]), done, pts)
             if code == _EXHAUSTED:
+                if self._labels is None:  # the next query between regions: no search
+                    self._labels = self._make_labels()
                 return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, done)
             if code == _HEAP_FULL:
                 self._grow_heap()
@@ -320,8 +352,8 @@ class AStarSearcher:
         h, w = self.shape
         if self._closed_gen < 0:
             return np.zeros((h, w), dtype=bool)
-        stamp = self._stamp.reshape(h + 2, w + 2)[1:-1, 1:-1]
-        return stamp == self._closed_gen
+        word = self._cell.reshape(h + 2, w + 2)[1:-1, 1:-1]
+        return (word != _BLOCKED) & ((word >> 5) == self._closed_gen)
 
     def expansion_order(self, goal_cell: tuple[int, int],
                         heuristic: str = "euclidean") -> np.ndarray:
@@ -382,14 +414,24 @@ def get_searcher(grid, corner_cutting: bool = False) -> AStarSearcher:
             _CACHE[grid] = per_map
         searcher = per_map.get(key)
     if searcher is None:
-        labels = None if key else grid.components
-        searcher = AStarSearcher(grid.occupied, corner_cutting=key, labels=labels)
+        searcher = _new_searcher(grid, key, None)
         with _CACHE_LOCK:
             searcher = per_map.setdefault(key, searcher)
     if searcher.lock.locked():
-        labels = searcher._labels
-        return AStarSearcher(grid.occupied, corner_cutting=key, labels=labels)
+        return _new_searcher(grid, key, searcher._labels)
     return searcher
+
+
+def _new_searcher(grid, corner_cutting: bool,  # type: ignore[no-untyped-def]
+                  labels: np.ndarray | None) -> AStarSearcher:
+    """A searcher on ``grid`` that takes its labels from the map's cache (eagerly on a
+    small map, on first need on a large one)."""
+    occ = grid.occupied
+    if labels is None and not corner_cutting and occ.size <= _EAGER_LABELS:
+        labels = grid.components
+    s = AStarSearcher(occ, corner_cutting=corner_cutting, labels=labels)
+    s._grid = weakref.ref(grid)
+    return s
 
 
 _WARM = False

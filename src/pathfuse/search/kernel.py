@@ -20,7 +20,8 @@ _HEAP_FULL = 3
 _CHUNK = 1 << 16  # expansions between clock checks when a time limit is set
 _RING_SCALE = 1024.0  # ring buckets per cell of f (euclidean open list)
 _RING_SIZE = 4096  # > 2 * sqrt(2) * _RING_SCALE + 2, a power of two
-_STAMP_LIMIT = np.iinfo(np.int32).max - 4
+_STAMP_LIMIT = (1 << 27) - 4  # stamps live in the 27 high bits of a cell's word
+_BLOCKED = np.uint32(0xFFFFFFFF)  # the word of a blocked (or border) cell
 
 
 # ----------------------------------------------------------------------------- kernels
@@ -36,7 +37,18 @@ def _bit_length(typingctx, x):
     return sig, codegen
 
 
-@njit(cache=True, nogil=True, inline="always")
+@intrinsic
+def _bits_of(typingctx, x):
+    """The IEEE-754 bits of a float64, as uint64 (an LLVM bitcast: no memory round trip)."""
+    sig = types.uint64(types.float64)
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.IntType(64))
+
+    return sig, codegen
+
+
+@njit(cache=True, nogil=True)
 def _heuristic(r: int, c: int, gr: int, gc: int, octile: bool) -> float:
     dy = abs(r - gr)
     dx = abs(c - gc)
@@ -47,7 +59,7 @@ def _heuristic(r: int, c: int, gr: int, gc: int, octile: bool) -> float:
     return math.sqrt(float(dx * dx + dy * dy))
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _qpush(qkey, qnode, qnext, heads, last, fh, used, key, node):
     """Insert (key, node) into the radix heap; returns (free-list head, used)."""
     if key < last:  # only by float rounding: f is monotone for a consistent heuristic
@@ -77,7 +89,7 @@ def _trailing_zeros(typingctx, x):
     return sig, codegen
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _spush(skey, snode, size, key, node):
     """Push onto the small binary min-heap of the current ring bucket."""
     i = size
@@ -94,7 +106,7 @@ def _spush(skey, snode, size, key, node):
     return size + 1
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _spop(skey, snode, size):
     """Pop the root of the small heap; returns (node, new size)."""
     top = snode[0]
@@ -124,15 +136,23 @@ def _spop(skey, snode, size):
 
 @njit(cache=True, nogil=True)
 def _astar_kernel(
-    free, gbuf, stamp, parent, qkey, qnode, qnext, heads, bits, skey, snode, meta, gen,
+    cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, gen,
     start, goal, wp, octile, corner_cutting, use_ring, max_exp,
 ):
     """Run A* until the goal is closed, the open list empties or ``max_exp`` expansions.
 
-    Cell state: ``stamp[p] == gen``: ``gbuf[p]`` is valid and ``p`` open;
-    ``stamp[p] == gen + 1``: ``p`` closed; ``parent[p]`` is the move (0-7)
-    that reached ``p``.  ``start >= 0`` starts a query; ``start < 0`` resumes
-    the one whose open list is saved in the arrays and ``meta``.
+    One ``uint32`` word per padded cell (``cell``) holds what a relaxation
+    reads: ``_BLOCKED`` (all bits set) on a blocked or border cell, else
+    ``stamp << 5 | move << 1`` with ``move`` (0-8) the move that reached it.
+    ``stamp == gen``: ``gbuf[p]`` is valid and ``p`` open; ``stamp == gen +
+    1``: ``p`` closed.  So one compare (``word >= (gen + 1) << 5``) rejects a
+    closed or blocked neighbour, bit 0 tells blocked from free for the corner
+    rule, and a cell's state costs one load from one array (the search is
+    bound by memory on large maps: separate free, stamp and parent arrays cost
+    2-4x more in the grid work).  Indices are unsigned (no negative-index
+    wraparound test on each access).  ``start >= 0`` starts a query;
+    ``start < 0`` resumes the one whose open list is saved in the arrays and
+    ``meta``.
 
     Two open lists, both exact and both keyed by the IEEE-754 bits of ``f``
     (non-negative doubles order like their bits); entries live in a pool
@@ -158,22 +178,27 @@ def _astar_kernel(
     this call).
     """
     s2 = 1.4142135623730951
-    fbuf = np.empty(1, dtype=np.float64)
-    ubuf = fbuf.view(np.uint64)
     one = np.uint64(1)
     rmask = _RING_SIZE - 1
     gr = goal // wp
     gc = goal - gr * wp
-    closed = gen + 1
-    offs = (1, -1, wp, -wp, wp + 1, wp - 1, -wp + 1, -wp - 1)
+    uw = np.uint64(wp)
+    ugoal = np.uint64(goal)
+    openv = np.uint32(gen << 5)
+    closedv = np.uint32((gen + 1) << 5)
+    bit0 = np.uint32(1)
+    low = np.uint32(31)
+    # the 8 moves as unsigned offsets (a negative offset wraps: p + offs[k] is exact)
+    offs = (one, ~np.uint64(0), uw, np.uint64(0) - uw, uw + one, uw - one, one - uw, ~uw)
     drs = (0, 0, 1, -1, 1, 1, -1, -1)
     dcs = (1, -1, 0, 0, 1, -1, 1, -1)
     if start >= 0:
-        gbuf[start] = 0.0
-        stamp[start] = gen
-        parent[start] = 8
+        us = np.uint64(start)
+        gbuf[us] = 0.0
+        cell[us] = openv | np.uint32(8 << 1)
         sr = start // wp
-        fbuf[0] = _heuristic(sr, start - sr * wp, gr, gc, octile)
+        f0 = _heuristic(sr, start - sr * wp, gr, gc, octile)
+        k0 = _bits_of(f0)
         fh = -1
         used = 0
         if use_ring:
@@ -182,13 +207,13 @@ def _astar_kernel(
             for i in range(_RING_SIZE // 64):
                 bits[i] = 0
             last = np.uint64(0)
-            cur = np.int64(fbuf[0] * _RING_SCALE)
+            cur = np.int64(f0 * _RING_SCALE)
             size = 0
-            ssize = _spush(skey, snode, 0, ubuf[0], start)
+            ssize = _spush(skey, snode, 0, k0, start)
         else:
             for i in range(65):
                 heads[i] = -1
-            last = ubuf[0]
+            last = k0
             cur = np.int64(0)
             fh, used = _qpush(qkey, qnode, qnext, heads, last, fh, used, last, start)
             size = 1
@@ -232,7 +257,7 @@ def _astar_kernel(
                     qnext[e] = fh
                     fh = e
                     e = nxt
-            p, ssize = _spop(skey, snode, ssize)
+            pi, ssize = _spop(skey, snode, ssize)
         else:
             if heads[0] < 0:
                 i = 1
@@ -257,65 +282,72 @@ def _astar_kernel(
                     e = nxt
             e = heads[0]
             heads[0] = qnext[e]
-            p = qnode[e]
+            pi = qnode[e]
             qnext[e] = fh
             fh = e
             size -= 1
-        if stamp[p] == closed:
+        p = np.uint64(pi)
+        sp = cell[p]
+        if sp >= closedv:
             continue  # stale duplicate of a node already expanded
-        stamp[p] = closed
+        cell[p] = closedv | (sp & low)
         n_exp += 1
-        if p == goal:
+        if p == ugoal:
             code = _FOUND
             break
         # ---- relax the 8 moves
         g0 = gbuf[p]
-        r = p // wp
-        c = p - r * wp
-        fe = free[p + 1]
-        fw = free[p - 1]
-        fn = free[p + wp]
-        fs = free[p - wp]
+        ur = p // uw
+        r = np.int64(ur)
+        c = np.int64(p - ur * uw)
+        se = cell[p + one]
+        sw = cell[p - one]
+        sn = cell[p + uw]
+        ss = cell[p - uw]
+        fe = (se & bit0) == 0
+        fw = (sw & bit0) == 0
+        fn = (sn & bit0) == 0
+        fs = (ss & bit0) == 0
         for k in range(8):
+            q = p + offs[k]
             if k < 4:
                 if k == 0:
-                    ok = fe
+                    st = se
                 elif k == 1:
-                    ok = fw
+                    st = sw
                 elif k == 2:
-                    ok = fn
+                    st = sn
                 else:
-                    ok = fs
+                    st = ss
                 step = 1.0
             else:
-                if k == 4:
-                    corner = fn and fe
-                elif k == 5:
-                    corner = fn and fw
-                elif k == 6:
-                    corner = fs and fe
-                else:
-                    corner = fs and fw
-                ok = free[p + offs[k]] and (corner_cutting or corner)
+                if not corner_cutting:
+                    if k == 4:
+                        corner = fn and fe
+                    elif k == 5:
+                        corner = fn and fw
+                    elif k == 6:
+                        corner = fs and fe
+                    else:
+                        corner = fs and fw
+                    if not corner:
+                        continue
+                st = cell[q]
                 step = s2
-            if not ok:
-                continue
-            q = p + offs[k]
-            st = stamp[q]
-            if st == closed:
-                continue
+            if st >= closedv:
+                continue  # blocked, or closed
             ng = g0 + step
-            if st == gen and ng >= gbuf[q]:
+            if st >= openv and ng >= gbuf[q]:
                 continue
             gbuf[q] = ng
-            stamp[q] = gen
-            parent[q] = k
+            cell[q] = openv | np.uint32(k << 1)
             f = ng + _heuristic(r + drs[k], c + dcs[k], gr, gc, octile)
-            fbuf[0] = f
+            kf = _bits_of(f)
+            qi = np.int64(q)
             if use_ring:
                 kq = np.int64(f * _RING_SCALE)
                 if kq <= cur:  # the bucket being expanded (or below it, by rounding)
-                    ssize = _spush(skey, snode, ssize, ubuf[0], q)
+                    ssize = _spush(skey, snode, ssize, kf, qi)
                 else:
                     if fh >= 0:
                         e = fh
@@ -323,15 +355,15 @@ def _astar_kernel(
                     else:
                         e = used
                         used += 1
-                    qkey[e] = ubuf[0]
-                    qnode[e] = q
+                    qkey[e] = kf
+                    qnode[e] = qi
                     b = kq & rmask
                     qnext[e] = heads[b]
                     heads[b] = e
                     bits[b >> 6] |= one << np.uint64(b & 63)
                     size += 1
             else:
-                fh, used = _qpush(qkey, qnode, qnext, heads, last, fh, used, ubuf[0], q)
+                fh, used = _qpush(qkey, qnode, qnext, heads, last, fh, used, kf, qi)
                 size += 1
     meta[0] = cur if use_ring else np.int64(last)
     meta[1] = fh
@@ -342,7 +374,7 @@ def _astar_kernel(
 
 
 @njit(cache=True, nogil=True)
-def _trace(parent, start, goal, wp, ox, oy, res):
+def _trace(cell, start, goal, wp, ox, oy, res):
     """The path from start to goal: ``(cells, points)``, the (n, 2) unpadded ``(row, col)``
     cells and their centres ``[x, y]`` for a grid of origin ``(ox, oy)`` and cell side
     ``res`` (one call, so a query pays one dispatch for both)."""
@@ -350,7 +382,7 @@ def _trace(parent, start, goal, wp, ox, oy, res):
     n = 1
     p = goal
     while p != start:
-        p -= offs[parent[p]]
+        p -= offs[(cell[p] >> 1) & 15]
         n += 1
     out = np.empty((n, 2), dtype=np.int64)
     pts = np.empty((n, 2))
@@ -362,5 +394,5 @@ def _trace(parent, start, goal, wp, ox, oy, res):
         pts[i, 0] = ox + (out[i, 1] + 0.5) * res
         pts[i, 1] = oy + (out[i, 0] + 0.5) * res
         if i > 0:
-            p -= offs[parent[p]]
+            p -= offs[(cell[p] >> 1) & 15]
     return out, pts

@@ -1,0 +1,317 @@
+"""Re-measure the speed figures the README quotes and write them into it.
+
+Each figure of the README's generated speed blocks comes from one benchmark's
+JSON output in ``benchmarks/results/``; this script runs the benchmarks, keeps
+their JSON there, and rewrites each block between its markers::
+
+    <!-- speed:NAME begin: written by benchmarks/run_all.py from benchmarks/results/NAME.json -->
+    ...
+    <!-- speed:NAME end -->
+
+so that no figure in those blocks is typed by hand.  ``tests/test_speed_docs.py``
+checks that every block equals what :func:`render` makes of its JSON.
+
+Blocks and their benchmarks:
+
+* ``peers``: ``bench_astar.py`` (A* against scipy, tcod and networkx under both corner
+  rules, wall time);
+* ``search``: ``bench_search.py`` (A*, jump point search, scipy, pyastar2d on the
+  hardest and on mixed MovingAI queries; expansions per second at 4096 x 4096);
+* ``plan``: ``bench_plan.py`` (the glue around the search, per map, and a tiny query);
+* ``startup``: ``bench_startup.py`` (import, ``--help``, a first plan on a cold and a
+  warm numba cache);
+* ``stepping``: ``bench_stepping.py`` (APF and fusion steps per second, fusion over A*).
+
+Usage::
+
+    python benchmarks/run_all.py [--only search peers plan startup stepping] [--no-run] [--check]
+
+``--no-run`` only rewrites the README from the JSON already there; ``--check``
+rewrites nothing and exits 1 when a block differs from its JSON.  The run takes
+about 10 minutes on 2 cores (``--only`` to run fewer); the machine's load is
+part of every block, as the machines are shared.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+RESULTS = HERE / "results"
+README = ROOT / "README.md"
+BLOCKS = ("search", "peers", "plan", "startup", "stepping")
+
+
+# ----------------------------------------------------------------------------- formatting
+def ms(x: float) -> str:
+    """Milliseconds, three significant digits (at least one decimal below 10)."""
+    if x >= 100:
+        return f"{x:.0f} ms"
+    if x >= 10:
+        return f"{x:.1f} ms"
+    if x >= 1:
+        return f"{x:.2f} ms"
+    return f"{x * 1000:.0f} µs" if x < 0.1 else f"{x:.3f} ms"
+
+
+def ratio(x: float) -> str:
+    return f"{x:.2f}" if x < 10 else f"{x:.1f}"
+
+
+def machine_line(m: dict[str, Any], load_end: float | None, command: str) -> str:
+    end = f" and {load_end} at the end" if load_end is not None else ""
+    return (f"Measured with `{command}` on {m['machine']}, {m['cores']} cores, load average "
+            f"{m['load']} at the start{end} (the machine is shared), Python {m['python']}"
+            + (f", numba {m['numba']}" if "numba" in m else "") + ".")
+
+
+# ----------------------------------------------------------------------------- blocks
+def render_search(r: dict[str, Any]) -> str:
+    out = [machine_line(r["machine"], r["load_end"], "python benchmarks/bench_search.py"),
+           "CPU time per query, median; in brackets the tool's time over `plan()`'s (planner "
+           "`astar` with its defaults), the median of the per-query ratios: above 1 the tool "
+           "is slower. numba compilation, the per-map buffers and the component labels are "
+           "made before any clock starts; scipy's graph is built beforehand."]
+    for part, title in (("hard", "Hardest queries: the {n} longest scenario lines of each map"),
+                        ("mixed", "Mixed queries: {n} scenario lines of each map drawn at "
+                                  "random (seed 0)")):
+        n = next(iter(r["maps"].values()))[part]["queries"]
+        out += ["", f"{title.format(n=n)}:", "",
+                "| map | `plan()` | `plan()`, octile | JPS searcher | scipy `dijkstra` "
+                "| pyastar2d |",
+                "|---|---|---|---|---|---|"]
+        for name, v in r["maps"].items():
+            t = v[part]["tools"]
+            cells = [ms(t["astar"]["cpu_ms"])]
+            for tool in ("astar-octile", "jps", "scipy", "pyastar2d"):
+                cells.append(f"{ms(t[tool]['cpu_ms'])} ({ratio(t[tool]['cpu_ratio'])})"
+                             if tool in t else "n/a")
+            out.append(f"| {name} | " + " | ".join(cells) + " |")
+    spans = [v[p]["tools"]["pyastar2d"]["len_over_opt"] for v in r["maps"].values()
+             for p in ("hard", "mixed") if "pyastar2d" in v[p]["tools"]]
+    jh = [v["hard"]["jps_vs_search_octile"] for v in r["maps"].values()]
+    jm = [v["mixed"]["jps_vs_search_octile"] for v in r["maps"].values()]
+    out += ["", ""]
+    if spans:  # pyastar2d is optional (not in the bench extra)
+        out[-1] = (f"pyastar2d's paths, measured under the MovingAI rules, are "
+                   f"{min(s[0] for s in spans):.2f}–{max(s[1] for s in spans):.2f} times the "
+                   f"optimum. ")
+    out[-1] += (f"Against the octile A* searcher (the same level: no `plan()` around either), "
+                f"JPS is {min(jh):.1f}–{max(jh):.1f}× faster on the hardest queries and "
+                f"{min(jm):.1f}–{max(jm):.1f}× on the mixed ones.")
+    if "big" in r:
+        b = r["big"]
+        e, o, j = b["astar-euclidean"], b["astar-octile"], b["jps"]
+        out += ["", f"{b['side']} × {b['side']} cells (Boston_0_1024 scaled up, each cell a "
+                f"block), its {b['queries']} longest scenario lines scaled: A* "
+                f"{e['mexp_per_cpu_s']:.1f} M expansions per CPU second with the Euclidean "
+                f"heuristic ({ms(e['cpu_ms'])}, {e['expansions']:,} expansions per query) and "
+                f"{o['mexp_per_cpu_s']:.1f} M with the octile one ({ms(o['cpu_ms'])}); JPS "
+                f"{ms(j['cpu_ms'])}. A new map of that size costs once: the A* buffers "
+                f"{b['astar_buffers_cpu_s']:.2f} s of CPU, the component labels "
+                f"{b['labels_cpu_s']:.2f} s (made only when a search first finds no path)."]
+    return "\n".join(out)
+
+
+def render_peers(r: dict[str, Any]) -> str:
+    rows = r["rows"]
+    maps = list(dict.fromkeys(x["map"] for x in rows))
+
+    def row(m: str, rule: str, tool: str) -> dict[str, Any] | None:
+        return next((x for x in rows if x["map"] == m and x["rule"] == rule
+                     and x["tool"] == tool), None)
+
+    def cell(x: dict[str, Any] | None, with_ratio: bool = True) -> str:
+        if x is None:
+            return "n/a"
+        if not with_ratio:
+            return ms(x["median_ms"])
+        return f"{ms(x['median_ms'])} ({ratio(x['ratio_vs_pathfuse_euclidean'])})"
+
+    out = [machine_line(r["machine"], r["load_end"], "python benchmarks/bench_astar.py"),
+           f"{r['queries']} scenario lines per map drawn at random (seed {r['seed']}), one "
+           "query at a time, interleaved; wall time per query, median; in brackets the "
+           "tool's time over pathfuse's with the Euclidean heuristic under the same corner "
+           "rule (above 1: pathfuse is faster). Graph builds, per-map buffers and numba "
+           "compilation are excluded for every tool.", "",
+           "| map, no corner cutting | pathfuse, Euclidean | pathfuse, octile | scipy "
+           "`dijkstra` | tcod `CustomGraph` | networkx `astar_path` |",
+           "|---|---|---|---|---|---|"]
+    for m in maps:
+        rule = "no corner cutting"
+        tc = [x for x in (row(m, rule, "tcod CustomGraph, new Pathfinder"),
+                          row(m, rule, "tcod CustomGraph, reused Pathfinder")) if x]
+        best = min(tc, key=lambda x: x["median_ms"]) if tc else None
+        out.append(f"| {m} | {cell(row(m, rule, 'pathfuse euclidean'), False)} | "
+                   f"{cell(row(m, rule, 'pathfuse octile'))} | "
+                   f"{cell(row(m, rule, 'scipy dijkstra'))} | {cell(best)} | "
+                   f"{cell(row(m, rule, 'networkx astar_path'))} |")
+    out += ["", "| map, corner cutting | pathfuse, Euclidean | pathfuse, octile | scipy "
+            "`dijkstra` | tcod `path2d` | tcod `AStar` (float) |", "|---|---|---|---|---|---|"]
+    for m in maps:
+        rule = "corner cutting"
+        out.append(f"| {m} | {cell(row(m, rule, 'pathfuse euclidean'), False)} | "
+                   f"{cell(row(m, rule, 'pathfuse octile'))} | "
+                   f"{cell(row(m, rule, 'scipy dijkstra'))} | "
+                   f"{cell(row(m, rule, 'tcod path2d'))} | "
+                   f"{cell(row(m, rule, 'tcod old AStar (float)'))} |")
+    dev = max((x["max_rel_length_dev"] for x in rows if x["tool"] == "tcod old AStar (float)"),
+              default=0.0)
+    out += ["", f"tcod's `CustomGraph` gets the rule without corner cutting from a per-edge "
+            f"`condition` array and integer costs (√2 approximated; the faster of a new and a "
+            f"reused `Pathfinder` is shown); scipy has no A* and no early exit, so it "
+            f"searches the whole map; tcod's old `AStar` stops when the goal is first reached, "
+            f"not expanded, with float32 costs, so its paths need not be optimal (here at most "
+            f"{100 * dev:.2f} % over pathfuse's)."]
+    return "\n".join(out)
+
+
+def render_plan(r: dict[str, Any]) -> str:
+    out = [machine_line(r["machine"], r["load_end"], "python benchmarks/bench_plan.py"),
+           "Wall time per query, median of the seeded sample; `plan()` is the public call, "
+           "the kernel the searcher alone, scipy its `dijkstra` with the walk back along the "
+           "predecessors.", "",
+           "| map | `plan()` µs | kernel µs | plan / kernel | scipy µs | scipy / plan |",
+           "|---|---|---|---|---|---|"]
+    for name, v in r["maps"].items():
+        out.append(f"| {name} | {v['plan_us']:.1f} | {v['kernel_us']:.1f} | "
+                   f"{v['plan_us'] / v['kernel_us']:.2f} | {v['scipy_us']:.1f} | "
+                   f"{v['scipy_us'] / v['plan_us']:.1f}× |")
+    t = r["tiny"]
+    out += ["", f"A tiny query (two neighbouring cells of Boston_0_1024, {t['expansions']} "
+            f"expansions) costs {t['plan_us']:.1f} µs in `plan()` and {t['kernel_us']:.1f} µs "
+            f"in the searcher (CPU {t['plan_cpu_us']:.1f} and {t['kernel_cpu_us']:.1f} µs): "
+            f"the fixed cost of a call is {t['plan_us'] - t['kernel_us']:.1f} µs."]
+    return "\n".join(out)
+
+
+def render_startup(r: dict[str, Any]) -> str:
+    out = [machine_line(r["machine"], r["load_end"], "python benchmarks/bench_startup.py"),
+           "Whole processes, CPU time (user + system) and wall time, medians; a cold run has "
+           "`NUMBA_CACHE_DIR` pointed at a new empty folder.", "",
+           "| command | CPU | wall |", "|---|---|---|",
+           f"| `python -c \"import pathfuse\"` | {r['import']['cpu_s']:.2f} s | "
+           f"{r['import']['wall_s']:.2f} s |",
+           f"| `pathfuse --help` | {r['help']['cpu_s']:.2f} s | {r['help']['wall_s']:.2f} s |"]
+    for key in r:
+        if key.startswith("plan-"):
+            for kind in ("cold", "warm"):
+                s = r[key][kind]
+                span = (f" ({s['cpu_min_s']:.1f}–{s['cpu_max_s']:.1f})"
+                        if kind == "cold" and s["runs"] > 1 else "")
+                out.append(f"| `pathfuse plan --map paper --planner {key[5:]}`, {kind} cache "
+                           f"| {s['cpu_s']:.2f} s{span} | {s['wall_s']:.2f} s |")
+    return "\n".join(out)
+
+
+def render_stepping(r: dict[str, Any]) -> str:
+    m = r["machine"]
+    side = r["big_map"]["side"]
+    return "\n".join([
+        machine_line(m, r["load_end"], "python benchmarks/bench_stepping.py"),
+        "",
+        f"* The stepping loops run at {r['apf_steps_per_s_paper'] / 1e6:.1f} million APF "
+        f"steps/s and {r['fusion_steps_per_s_paper'] / 1e6:.1f} million fusion steps/s on the "
+        f"{r['paper_seeds']} paper maps, and at {r['apf_big_over_paper']:.2f} and "
+        f"{r['fusion_big_over_paper']:.2f} times those rates on a {side} × {side} map: the "
+        f"repulsion reads a local window, so a step costs the same on a map of any size.",
+        f"* Fusion planning at its default step costs {r['fusion_over_astar_median']:.2f}× the "
+        f"A* planning on the same paper maps (median {r['fusion_time_median_s'] * 1e6:.1f} µs "
+        f"against {r['astar_time_median_s'] * 1e6:.1f} µs; the paper reports 1.56× in "
+        f"MATLAB); as whole `plan()` calls, {r['fusion_over_astar_wall_median']:.2f}×. The "
+        f"fusion's time is mostly its stepping, so a faster A* raises this ratio.",
+    ])
+
+
+RENDER: dict[str, Callable[[dict[str, Any]], str]] = {
+    "search": render_search, "peers": render_peers, "plan": render_plan, "startup": render_startup,
+    "stepping": render_stepping}
+
+
+def render(name: str) -> str:
+    """The Markdown of block ``name`` from ``benchmarks/results/NAME.json``."""
+    return RENDER[name](json.loads((RESULTS / f"{name}.json").read_text()))
+
+
+def _pattern(name: str) -> re.Pattern[str]:
+    return re.compile(rf"(<!-- speed:{name} begin[^\n]*-->\n)(.*?)(\n<!-- speed:{name} end -->)",
+                      re.S)
+
+
+def blocks_in(text: str) -> dict[str, str]:
+    """The generated blocks of a README text, by name."""
+    out = {}
+    for name in BLOCKS:
+        m = _pattern(name).search(text)
+        if m:
+            out[name] = m.group(2)
+    return out
+
+
+def rewrite(text: str, names: list[str]) -> str:
+    for name in names:
+        pat = _pattern(name)
+        if not pat.search(text):
+            raise SystemExit(f"README.md has no block speed:{name}")
+        body = render(name)
+        text = pat.sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
+    return text
+
+
+def run(name: str) -> None:
+    """Run the benchmark of block ``name``, its JSON into benchmarks/results/."""
+    sys.path.insert(0, str(HERE))
+    RESULTS.mkdir(exist_ok=True)
+    out = str(RESULTS / f"{name}.json")
+    print(f"\n==== {name}", flush=True)
+    if name == "search":
+        import bench_search
+
+        bench_search.main(["--json", out])
+    elif name == "peers":
+        import bench_astar
+
+        bench_astar.main(["--json", out])
+    elif name == "plan":
+        import bench_plan
+
+        bench_plan.main(["--json", out])
+    elif name == "startup":
+        import bench_startup
+
+        bench_startup.main(["--json", out])
+    elif name == "stepping":
+        import bench_stepping
+
+        bench_stepping.main(["--json", out])
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", nargs="+", choices=BLOCKS, default=list(BLOCKS))
+    ap.add_argument("--no-run", action="store_true", help="only rewrite the README")
+    ap.add_argument("--check", action="store_true",
+                    help="exit 1 when a README block differs from its JSON")
+    args = ap.parse_args(argv)
+    text = README.read_text()
+    if args.check:
+        bad = [n for n, body in blocks_in(text).items() if body != render(n)]
+        print("stale blocks: " + ", ".join(bad) if bad else "every block is up to date")
+        return 1 if bad else 0
+    if not args.no_run:
+        for name in args.only:
+            run(name)
+    README.write_text(rewrite(README.read_text(), args.only))
+    print(f"\nrewrote the blocks {', '.join(args.only)} of {README}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,33 @@
+"""Start-up of the command line: `pathfuse --help` loads no numpy, and the defaults its
+help text writes out agree with the library's."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+
+def test_help_imports_no_numpy():
+    code = ("import sys, contextlib, io\n"
+            "from pathfuse.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    try:\n"
+            "        main(['--help'])\n"
+            "    except SystemExit:\n"
+            "        pass\n"
+            "print(sorted(m for m in ('numpy', 'numba', 'scipy') if m in sys.modules))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=60)
+    assert out.stdout.strip() == "[]", out.stdout
+
+
+def test_barn_help_states_the_jackal_defaults():
+    from pathfuse.cli import build_parser
+    from pathfuse.studies.barn import JACKAL_MAX_SPEED_M_S, JACKAL_RADIUS_M
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    text = sub.choices["barn"].format_help()
+    flat = " ".join(text.split())
+    assert f"(default {JACKAL_RADIUS_M:g}: the Jackal's" in flat
+    assert f"(default {JACKAL_MAX_SPEED_M_S:g}, the Jackal's)" in flat

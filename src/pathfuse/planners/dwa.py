@@ -84,17 +84,7 @@ import numpy as np
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
-from pathfuse.planners.dwa_kernel import (
-    D_GREF,
-    D_MARGIN,
-    D_NEAR,
-    D_VMAX,
-    D_WKEEP,
-    D_WOBS,
-    dwa_choose,
-    pack_dwa,
-    path_gap,
-)
+from pathfuse.planners.dwa_kernel import dwa_choose, pack_dwa, relaxed, set_keep_reference
 from pathfuse.planners.params import GlobalAStarParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -205,10 +195,7 @@ class DWAController(Controller):
         self.no_choice = 0
         self._sensed = _NO_DISCS
         self._relaxed_until = -1
-        self._f_relaxed = self.f.copy()
-        self._f_relaxed[D_WOBS] = 0.0
-        self._f_relaxed[D_MARGIN] = 0.0
-        self._f_relaxed[D_WKEEP] = 0.0
+        self._f_relaxed = relaxed(self.f)
 
     def _set_path(self, pts: np.ndarray) -> None:
         gx, gy = self.problem.goal
@@ -262,9 +249,7 @@ class DWAController(Controller):
                                       g.occupied, float(g.origin[0]), float(g.origin[1]),
                                       float(g.resolution), self.clear_m))
         f = self._f_relaxed if self.ticks <= self._relaxed_until else self.f
-        if f[D_WKEEP] > 0.0:
-            f[D_GREF] = path_gap(g.occupied, f, self.pts, self.cum, self.k,
-                                 max(f[D_VMAX] * f[D_NEAR], 0.5))
+        set_keep_reference(g.occupied, f, self.pts, self.cum, self.k)
         a0, a1, count, _ = dwa_choose(self.problem.grid.occupied, f, x, y, th, c0, c1,
                                       self.pts, self.cum, self.k, dpos, dvel, drad)
         if count == 0:

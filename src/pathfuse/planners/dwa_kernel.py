@@ -22,7 +22,8 @@ from pathfuse.sweep import (
     unicycle_pose,
 )
 
-__all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "N_D"]
+__all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "relaxed", "set_keep_reference",
+           "N_D"]
 
 (D_DT, D_VMIN, D_VMAX, D_AMAX, D_WMAX, D_ALPHA, D_RADIUS, D_CLEAR, D_MARGIN, D_HORIZON,
  D_SIMDT, D_NV, D_NW, D_WPATH, D_WGOAL, D_WHEAD, D_WSPEED, D_WOBS, D_WDYN, D_RANGE,
@@ -48,6 +49,24 @@ def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, 
     for i, v in enumerate(vals):
         f[i] = float(v)
     return f
+
+
+def relaxed(f):
+    """A copy of the settings ``f`` without the obstacle and keep critics and the margin (the
+    recovery behaviour that clears them, :mod:`pathfuse.planners.recovery`)."""
+    out = f.copy()
+    out[D_WOBS] = 0.0
+    out[D_MARGIN] = 0.0
+    out[D_WKEEP] = 0.0
+    return out
+
+
+def set_keep_reference(occ, f, pts, cum, k):
+    """Store in ``f`` the keep critic's reference for this tick: the gap the path ``pts``
+    keeps from its point ``k`` over what the robot travels in ``keep_horizon_s`` at full
+    speed (at least 0.5 m).  Nothing when the critic is off."""
+    if f[D_WKEEP] > 0.0:
+        f[D_GREF] = path_gap(occ, f, pts, cum, k, max(f[D_VMAX] * f[D_NEAR], 0.5))
 
 
 @njit(cache=True, inline="always")

@@ -53,15 +53,11 @@ from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.base import sensed_discs
 from pathfuse.planners.dwa_kernel import (
-    D_GREF,
-    D_MARGIN,
-    D_NEAR,
-    D_WKEEP,
-    D_WOBS,
     dwa_choose,
     dwa_progress,
     pack_dwa,
-    path_gap,
+    relaxed,
+    set_keep_reference,
 )
 
 __all__ = ["ForceWindow", "PASSIVE_WINDOW"]
@@ -136,10 +132,7 @@ class ForceWindow:
         self.ticks = 0
         self.relaxed_until = -1
         self.relax_replan = False
-        self.f_relaxed = self.f.copy()
-        self.f_relaxed[D_WOBS] = 0.0
-        self.f_relaxed[D_MARGIN] = 0.0
-        self.f_relaxed[D_WKEEP] = 0.0
+        self.f_relaxed = relaxed(self.f)
 
     def relax(self, seconds: float) -> None:
         """Recovery (ours, as Nav2's clear-costmap): no obstacle critic and no margin for
@@ -217,12 +210,10 @@ class ForceWindow:
         if abs(err) > self.rotate_rad:
             return self._rotate(err)
         f = self.f_relaxed if self.ticks <= self.relaxed_until else self.f
-        if f[D_WKEEP] > 0.0:
-            # the keep critic's reference: the gap the A* path keeps ahead (the local path
-            # is the field's streamline, which may graze)
-            kk0 = min(max(int(k), 0), pts.shape[0] - 1)
-            f[D_GREF] = path_gap(self.problem.grid.occupied, f, pts, cum, kk0,
-                                 max(self.vmax * float(f[D_NEAR]), 0.5))
+        # the keep critic's reference: the gap the A* path keeps ahead (the local path is
+        # the field's streamline, which may graze)
+        set_keep_reference(self.problem.grid.occupied, f, pts, cum,
+                           min(max(int(k), 0), pts.shape[0] - 1))
         a0, a1, _, _ = dwa_choose(self.problem.grid.occupied, f, x, y,
                                   float(obs.heading), float(cmd[0]), float(cmd[1]), path, pcum,
                                   kk, dpos, dvel, drad)

@@ -175,7 +175,9 @@ an animation plays in real time unless that takes more than 150 frames, then fas
     sm.add_argument("--param", action="append", metavar="KEY=VALUE",
                     help="planner parameter, repeatable (e.g. --param repulsion=velocity)")
     sm.add_argument("--seed", type=_nonneg_int, default=None,
-                    help="episode seed for random walks (default: the scenario's)")
+                    help="episode seed: mixed into random walks and, where the scenario has "
+                         "a perturb: section, draws the discs' jitter (default: the "
+                         "scenario's)")
     sm.add_argument("--robot", action="append", metavar="KEY=VALUE",
                     help="override a key of the scenario's robot: block, repeatable (e.g. "
                     "--robot model=diff-drive --robot clearance=0.1)")

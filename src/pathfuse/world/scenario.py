@@ -20,6 +20,10 @@ A complete, documented file (``examples/scenarios/crossing.yaml`` holds it)::
     stall_time: 10                 # s; LOCAL_MINIMUM when the robot stays within
     stall_radius: 0.25             #    stall_radius m for stall_time s (0 disables)
     seed: null                     # optional episode seed (random walks); an int or null
+    perturb:                       # optional (ours): with a seed, jitter every disc
+      position_m: 0.3              #   start (patrol: waypoints) moved by up to 0.3 m
+      speed_frac: 0.2              #   speed scaled by a factor in [0.8, 1.2]
+      heading_deg: 10              #   a linear disc's direction turned by up to 10 deg
     obstacles:                     # moving discs (default: none)
       - {position: [6, 2], velocity: [0, 0.5], radius: 0.3}               # constant velocity,
                                                                           # bounces
@@ -75,6 +79,7 @@ from pathfuse.world.obstacles import (
     PatrolObstacle,
     RandomWalkObstacle,
 )
+from pathfuse.world.perturb import PERTURB_KEYS, Perturbation, perturb_obstacles
 from pathfuse.world.robot import RobotSpec, parse_robot
 
 __all__ = [
@@ -95,7 +100,8 @@ class ScenarioError(ConfigError):
 
 
 SCENARIO_KEYS = ("name", "description", "map", "start", "goal", "robot", "dt", "time_limit",
-                 "goal_tolerance", "stall_time", "stall_radius", "seed", "obstacles", "planner")
+                 "goal_tolerance", "stall_time", "stall_radius", "seed", "perturb", "obstacles",
+                 "planner")
 """The keys a scenario file may have."""
 _REQUIRED = ("map", "start", "goal")
 _LINEAR_KEYS = ("position", "velocity", "radius")
@@ -143,6 +149,8 @@ class Scenario:
         The online planner to run (overridable in :func:`~pathfuse.simulate`).
     seed : int or None
         Default episode seed (mixed into the random walks' seeds).
+    perturb : Perturbation or None
+        Seeded jitter of the discs (:mod:`pathfuse.world.perturb`; ours).
     stall_time, stall_radius : float
         Stall detection of the episode runner (``stall_time = 0`` disables).
     name, description : str
@@ -163,6 +171,7 @@ class Scenario:
     obstacles: tuple[ObstacleSpec, ...] = ()
     planner: PlannerChoice = field(default_factory=PlannerChoice)
     seed: int | None = None
+    perturb: Perturbation | None = None
     stall_time: float = 10.0
     stall_radius: float = 0.25
     name: str = "scenario"
@@ -177,6 +186,30 @@ class Scenario:
     def n_steps(self) -> int:
         """Number of ticks that fit in ``time_limit``: ``ceil(time_limit / dt)``."""
         return max(1, int(math.ceil(self.time_limit / self.dt - 1e-9)))
+
+    def obstacles_for(self, seed: int | None) -> tuple[ObstacleSpec, ...]:
+        """The discs of the episode with ``seed``: as written without a seed or a
+        ``perturb`` section, else jittered (:func:`~pathfuse.world.perturb.perturb_obstacles`).
+
+        >>> sc = load_scenario({"map": {"rows": ["......"] * 3}, "start": [0.5, 1.5],
+        ...                     "goal": [5.5, 1.5], "perturb": {"position_m": 0.3},
+        ...                     "obstacles": [{"position": [3, 1.5], "velocity": [-0.5, 0]}]})
+        >>> sc.obstacles_for(None) == sc.obstacles, sc.obstacles_for(1) == sc.obstacles_for(1)
+        (True, True)
+        >>> sc.obstacles_for(1) != sc.obstacles_for(2)
+        True
+        """
+        if seed is None or self.perturb is None or not self.perturb.active:
+            return self.obstacles
+
+        def valid(i: int, ob: ObstacleSpec) -> bool:
+            try:
+                _check_disc(self, i, ob)
+            except ScenarioError:
+                return False
+            return True
+
+        return perturb_obstacles(self.obstacles, self.perturb, int(seed), valid)
 
     def replace(self, **changes: Any) -> Scenario:
         """A copy with some fields changed (re-validated)."""
@@ -216,6 +249,8 @@ class Scenario:
             "obstacles": [ob.to_dict() for ob in self.obstacles],
             "planner": self.planner.to_dict(),
         }
+        if self.perturb is not None:
+            d["perturb"] = self.perturb.to_dict()
         return d
 
 
@@ -294,30 +329,43 @@ def _check_scene(sc: Scenario) -> None:
     _check_point(sc.grid, sc.start, r, "start", "the robot")
     _check_point(sc.grid, sc.goal, r, "goal", "the robot")
     for i, ob in enumerate(sc.obstacles):
-        key = f"obstacles[{i}]"
-        if isinstance(ob, PatrolObstacle):
-            for j, w in enumerate(ob.waypoints):
-                _check_point(sc.grid, w, ob.radius, f"{key}.waypoints[{j}]", "the disc")
-            poly = ob.polyline()
-            g = sc.grid
-            for j in range(len(poly) - 1):
-                a, b = poly[j], poly[j + 1]
-                d = segment_static_distance(g.occupied, g.origin[0], g.origin[1], g.resolution,
-                                            a[0], a[1], b[0], b[1], ob.radius)
-                if d < ob.radius:
-                    jn = (j + 1) % len(ob.waypoints)
-                    raise ScenarioError(
-                        f"{key}.waypoints: the leg from waypoint {j} to waypoint {jn} is "
-                        f"blocked for a disc of radius {ob.radius:g} m"
-                    )
-        else:
-            pkey = f"{key}.random_walk.position" if isinstance(ob, RandomWalkObstacle) \
-                else f"{key}.position"
-            _check_point(sc.grid, ob.position, ob.radius, pkey, "the disc")
-        gap = math.hypot(ob.position[0] - sc.start[0], ob.position[1] - sc.start[1]) \
-            - ob.radius - r
-        if gap < 0:
-            raise ScenarioError(f"{key}: overlaps the robot at the start (by {-gap:.3g} m)")
+        _check_disc(sc, i, ob)
+    if sc.perturb is not None:
+        p = sc.perturb
+        if not isinstance(p, Perturbation):
+            raise ScenarioError(f"perturb: must be a Perturbation, got {type(p).__name__}")
+        _num(p.position_m, "perturb.position_m", ge=0)
+        _num(p.speed_frac, "perturb.speed_frac", ge=0, lt=1)
+        _num(p.heading_deg, "perturb.heading_deg", ge=0, le=180)
+
+
+def _check_disc(sc: Scenario, i: int, ob: ObstacleSpec) -> None:
+    """Disc ``i`` lies in the map, clear of occupied cells and of the robot's start (a
+    patrol: every waypoint and leg)."""
+    key = f"obstacles[{i}]"
+    if isinstance(ob, PatrolObstacle):
+        for j, w in enumerate(ob.waypoints):
+            _check_point(sc.grid, w, ob.radius, f"{key}.waypoints[{j}]", "the disc")
+        poly = ob.polyline()
+        g = sc.grid
+        for j in range(len(poly) - 1):
+            a, b = poly[j], poly[j + 1]
+            d = segment_static_distance(g.occupied, g.origin[0], g.origin[1], g.resolution,
+                                        a[0], a[1], b[0], b[1], ob.radius)
+            if d < ob.radius:
+                jn = (j + 1) % len(ob.waypoints)
+                raise ScenarioError(
+                    f"{key}.waypoints: the leg from waypoint {j} to waypoint {jn} is "
+                    f"blocked for a disc of radius {ob.radius:g} m"
+                )
+    else:
+        pkey = f"{key}.random_walk.position" if isinstance(ob, RandomWalkObstacle) \
+            else f"{key}.position"
+        _check_point(sc.grid, ob.position, ob.radius, pkey, "the disc")
+    gap = math.hypot(ob.position[0] - sc.start[0], ob.position[1] - sc.start[1]) \
+        - ob.radius - sc.robot.radius
+    if gap < 0:
+        raise ScenarioError(f"{key}: overlaps the robot at the start (by {-gap:.3g} m)")
 
 
 # ---------------------------------------------------------------------- value parsers
@@ -325,8 +373,8 @@ def _check_scene(sc: Scenario) -> None:
 
 
 def _num(v: Any, key: str, *, gt: float | None = None, ge: float | None = None,
-         le: float | None = None) -> float:
-    return validate.number(v, key, gt=gt, ge=ge, le=le, error=ScenarioError)
+         lt: float | None = None, le: float | None = None) -> float:
+    return validate.number(v, key, gt=gt, ge=ge, lt=lt, le=le, error=ScenarioError)
 
 
 def _int(v: Any, key: str, *, ge: int = 0) -> int:
@@ -353,6 +401,17 @@ def _mapping(v: Any, key: str, allowed: tuple[str, ...], what: str = "a mapping"
 
 
 # ---------------------------------------------------------------------- section parsers
+def _parse_perturb(v: Any) -> Perturbation | None:
+    if v is None:
+        return None
+    m = _mapping(v, "perturb", PERTURB_KEYS)
+    return Perturbation(
+        position_m=_num(m.get("position_m", 0.0), "perturb.position_m", ge=0),
+        speed_frac=_num(m.get("speed_frac", 0.0), "perturb.speed_frac", ge=0, lt=1),
+        heading_deg=_num(m.get("heading_deg", 0.0), "perturb.heading_deg", ge=0, le=180),
+    )
+
+
 def _parse_obstacle(v: Any, index: int) -> ObstacleSpec:
     key = f"obstacles[{index}]"
     if not isinstance(v, Mapping):
@@ -487,6 +546,7 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
         stall_time=_num(doc.get("stall_time", 10.0), "stall_time", ge=0),
         stall_radius=_num(doc.get("stall_radius", 0.25), "stall_radius", gt=0),
         seed=None if seed is None else _int(seed, "seed"),
+        perturb=_parse_perturb(doc.get("perturb")),
         obstacles=tuple(_parse_obstacle(o, i) for i, o in enumerate(obstacles)),
         planner=_parse_planner(doc.get("planner")),
         name=_str(name, "name"),

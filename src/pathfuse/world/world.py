@@ -263,12 +263,14 @@ class World:
         """Start an episode: the robot at the start, the clock at 0, the discs at tick 0.
 
         ``seed`` (default: the scenario's ``seed``) is mixed into the random
-        walks' seeds; the same scenario and seed give the same episode.
+        walks' seeds and draws the scenario's ``perturb`` jitter of the discs
+        (:meth:`~pathfuse.world.scenario.Scenario.obstacles_for`); the same
+        scenario and seed give the same episode.
         """
         sc = self.scenario
         self.seed = sc.seed if seed is None else int(seed)
         self.obstacle_positions, self.obstacle_velocities = obstacle_trajectories(
-            sc.obstacles, sc.grid, self.dt, self.n_steps, self.seed)
+            sc.obstacles_for(self.seed), sc.grid, self.dt, self.n_steps, self.seed)
         self.obstacle_positions.setflags(write=False)
         self.obstacle_velocities.setflags(write=False)
         self.position = np.array(sc.start, dtype=np.float64)

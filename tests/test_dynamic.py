@@ -104,6 +104,10 @@ def test_summary_csv_agrees_with_an_independent_computation(files):
             assert float(row[f"{key}_ci_high"]) == pytest.approx(hi, abs=1e-9)
         assert total == n
         ok = [e for e in mine if e["status"] == "SUCCESS"]
+        # a social success: reached and never within 0.3 m of a disc (no disc: inf gap)
+        k = sum(float(e["min_obstacle_distance_m"] or "inf") >= 0.3 for e in ok)
+        assert int(row["social"]) == k
+        assert float(row["social_rate"]) == pytest.approx(wilson(k, n)[0], abs=1e-12)
         for col, label, unit in (("path_length_m", "path_length", "m"),
                                  ("time_to_goal_s", "time_to_goal", "s")):
             vals = [float(e[col]) for e in ok]

@@ -84,9 +84,17 @@ import numpy as np
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
-from pathfuse.planners.dwa_kernel import dwa_choose, pack_dwa, relaxed, set_keep_reference
-from pathfuse.planners.params import GlobalAStarParams
+from pathfuse.planners.dwa_kernel import (
+    dwa_choose,
+    pack_dwa,
+    relaxed,
+    route_tangent,
+    set_keep_reference,
+    set_route,
+)
+from pathfuse.planners.params import GlobalAStarParams, SocialParams
 from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.planners.social import PassingSides, disc_ids
 from pathfuse.problem import Problem
 from pathfuse.result import Status
 from pathfuse.robot import RobotModel
@@ -97,7 +105,7 @@ __all__ = ["DWAParams", "DWAController"]
 
 
 @dataclass(frozen=True)
-class DWAParams(GlobalAStarParams):
+class DWAParams(GlobalAStarParams, SocialParams):
     """Parameters of ``dwa`` (the sampling, the horizon and the critics' weights)."""
 
     v_samples: int = param(7, ge=2, help="linear speeds sampled in the window (holonomic: "
@@ -190,7 +198,9 @@ class DWAController(Controller):
             p.lookahead_m, p.inflation_decay_m, not rb.is_diff_drive, ox, oy, g.resolution,
             p.passive_safety,
             w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
-            keep_m=p.keep_m)
+            keep_m=p.keep_m, w_social=p.social_weight if p.social else 0.0,
+            personal_m=p.personal_m, w_side=p.side_weight if p.social else 0.0)
+        self.sides = PassingSides(p.personal_m)
         self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
         self.no_choice = 0
         self._sensed = _NO_DISCS
@@ -238,7 +248,8 @@ class DWAController(Controller):
     _pending_replan = False
 
     def _choose(self, x: float, y: float, th: float, c0: float, c1: float, dpos: np.ndarray,
-                dvel: np.ndarray, drad: np.ndarray) -> tuple[float, float]:
+                dvel: np.ndarray, drad: np.ndarray, ids: np.ndarray | None = None
+                ) -> tuple[float, float]:
         if self._pending_replan or (self.replan_every and self.ticks
                                     and self.ticks % self.replan_every == 0):
             self._pending_replan = False
@@ -250,8 +261,17 @@ class DWAController(Controller):
                                       float(g.resolution), self.clear_m))
         f = self._f_relaxed if self.ticks <= self._relaxed_until else self.f
         set_keep_reference(g.occupied, f, self.pts, self.cum, self.k)
+        n = drad.shape[0]
+        ids = np.arange(n) if ids is None else ids
+        chosen = np.zeros((n, 2))
+        route = route_tangent(self.pts, self.k, th)
+        set_route(f, route)
         a0, a1, count, _ = dwa_choose(self.problem.grid.occupied, f, x, y, th, c0, c1,
-                                      self.pts, self.cum, self.k, dpos, dvel, drad)
+                                      self.pts, self.cum, self.k, dpos, dvel, drad,
+                                      self.sides.sides(ids), chosen)
+        if n:
+            self.sides.update(ids, chosen, dpos, (x, y), route, drad,
+                              self.problem.robot_radius_m)
         if count == 0:
             self.no_choice += 1
         return float(a0), float(a1)
@@ -264,7 +284,7 @@ class DWAController(Controller):
         cmd = obs.command
         a0, a1 = self._choose(float(obs.position[0]), float(obs.position[1]),
                               float(obs.heading), float(cmd[0]), float(cmd[1]), dpos, dvel,
-                              drad)
+                              drad, disc_ids(obs, drad.shape[0]))
         return np.array([a0, a1])
 
     # ------------------------------------------------------------------ offline
@@ -344,7 +364,7 @@ class DWAController(Controller):
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:
-        return (dwa_choose, advance_progress)
+        return (dwa_choose, advance_progress, route_tangent)
 
     @classmethod
     def warmup(cls) -> None:
@@ -367,7 +387,8 @@ class DWAController(Controller):
                 q = np.ones((1, 2))
                 q.setflags(write=not ro)
                 dwa_choose(g.occupied, c.f, 0.5, 0.5, 0.0, 0.0, 0.0, c.pts, c.cum, 0, q, q,
-                           np.ones(1))
+                           np.ones(1), np.zeros(1), np.zeros((1, 2)))
+        route_tangent(c.pts, 0, 0.0)
         _WARM[0] = True
 
 

@@ -23,13 +23,13 @@ from pathfuse.sweep import (
 )
 
 __all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "relaxed", "set_keep_reference",
-           "N_D"]
+           "route_tangent", "set_route", "N_D"]
 
 (D_DT, D_VMIN, D_VMAX, D_AMAX, D_WMAX, D_ALPHA, D_RADIUS, D_CLEAR, D_MARGIN, D_HORIZON,
  D_SIMDT, D_NV, D_NW, D_WPATH, D_WGOAL, D_WHEAD, D_WSPEED, D_WOBS, D_WDYN, D_RANGE,
  D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES, D_PASSIVE, D_WALIGN, D_NEAR, D_WKEEP, D_KEEP,
- D_GREF) = range(32)
-N_D = 32
+ D_GREF, D_WSOC, D_PERSONAL, D_WSIDE, D_TX, D_TY) = range(37)
+N_D = 37
 SOFT = 0.3
 KEEP_FLOOR = 0.02
 """The keep critic's shortfall is relative to the path's gap, but to at least this (m)."""
@@ -39,13 +39,13 @@ PASSIVE_COST = 20.0
 def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
              n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
              decay, holonomic, ox, oy, res, passive=True, w_align=0.0, near_s=0.0,
-             w_keep=0.0, keep_m=0.3):
+             w_keep=0.0, keep_m=0.3, w_social=0.0, personal_m=0.5, w_side=0.0):
     """The settings array of :func:`dwa_choose`."""
     f = np.zeros(N_D)
     vals = (dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
             n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
             decay, 1.0 if holonomic else 0.0, ox, oy, res, 1.0 if passive else 0.0,
-            w_align, near_s, w_keep, keep_m, np.inf)
+            w_align, near_s, w_keep, keep_m, np.inf, w_social, personal_m, w_side, 0.0, 0.0)
     for i, v in enumerate(vals):
         f[i] = float(v)
     return f
@@ -72,6 +72,28 @@ def set_keep_reference(occ, f, pts, cum, k):
 @njit(cache=True, inline="always")
 def _wrap(a):
     return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def set_route(f, tangent):
+    """Store in ``f`` the route direction against which passing sides are told."""
+    f[D_TX] = float(tangent[0])
+    f[D_TY] = float(tangent[1])
+
+
+@njit(cache=True)
+def route_tangent(pts, k, th):
+    """The unit direction of the path at its point ``k`` (the heading ``th`` where the path
+    has no length there): the route against which a disc's passing side is told."""
+    m = pts.shape[0]
+    j = min(max(k, 0), m - 1)
+    while j + 1 < m:
+        tx = pts[j + 1, 0] - pts[j, 0]
+        ty = pts[j + 1, 1] - pts[j, 1]
+        n = math.hypot(tx, ty)
+        if n > 1e-9:
+            return tx / n, ty / n
+        j += 1
+    return math.cos(th), math.sin(th)
 
 
 @njit(cache=True)
@@ -152,8 +174,11 @@ def path_gap(occ, f, pts, cum, k, length):
 
 
 @njit(cache=True)
-def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
-    """Score one sample: ``out = [cost, admissible, first_tick_clear]``."""
+def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx, ty, dside,
+             sides):
+    """Score one sample: ``out = [cost, admissible, first_tick_clear]``; ``sides[j] = (side,
+    least predicted gap)`` of the sample against sensed disc ``j`` (the social critics,
+    :mod:`pathfuse.planners.social`; ``(tx, ty)`` the route's direction)."""
     ox = f[D_OX]
     oy = f[D_OY]
     res = f[D_RES]
@@ -195,6 +220,9 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
         reach[j] = math.hypot(dvel[j, 0], dvel[j, 1]) * stop_s
     gmin = np.inf
     dmaxr = 0.0
+    for j in range(n_disc):
+        sides[j, 0] = 0.0
+        sides[j, 1] = np.inf
     near = f[D_NEAR]
     dnear = cap
     # the path-align critic holds the robot to the global path: not while a moving disc is
@@ -249,7 +277,18 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
             rr[0] = drad[j]
             # less how far the disc can come while the robot stops from here (so a pass
             # that the shield's passive-safety test would refuse counts as a collision)
-            g = disc_sweep_gaps(pa, pb, radius, qa, qb, rr)[0] - e - reach[j]
+            g0 = disc_sweep_gaps(pa, pb, radius, qa, qb, rr)[0] - e
+            if g0 < sides[j, 1]:
+                # the side of the route the disc is on at the closest approach so far
+                mx = 0.5 * (qa[0, 0] + qb[0, 0]) - 0.5 * (ax + bx)
+                my = 0.5 * (qa[0, 1] + qb[0, 1]) - 0.5 * (ay + by)
+                # (the disc's signed offset from the robot across the route; a pass only
+                # where the two are side by side, not one behind the other)
+                cr = tx * my - ty * mx
+                beside = radius + drad[j]
+                sides[j, 0] = 1.0 if cr > beside else (-1.0 if cr < -beside else 0.0)
+                sides[j, 1] = g0
+            g = g0 - reach[j]
             if g < gmin:
                 gmin = g
                 dmaxr = drad[j]
@@ -277,6 +316,21 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
             dyn = 1.5 + 2.0 * min(-gmin / (radius + dmaxr), 1.0) + 0.5 * (horizon - tc) / horizon
         elif gmin < np.inf:
             dyn = SOFT * math.exp(-max(gmin, 0.0) / 0.2)
+    soc = 0.0
+    side_cost = 0.0
+    personal = f[D_PERSONAL]
+    if n_disc > 0 and (f[D_WSOC] > 0.0 or f[D_WSIDE] > 0.0):
+        # ours (pathfuse.planners.social): personal space over the predicted gaps, and the
+        # committed passing sides
+        for j in range(n_disc):
+            gj = sides[j, 1]
+            if gj < personal:
+                sh = (personal - max(gj, 0.0)) / personal
+                if sh * sh > soc:
+                    soc = sh * sh
+            if dside[j] != 0.0 and sides[j, 0] != 0.0 and sides[j, 0] != dside[j] \
+                    and gj < personal + 1.0:
+                side_cost = 1.0
     # the end point against the path near the progress index: its distance to the path and
     # how much path is left beyond its projection
     m = pts.shape[0]
@@ -307,7 +361,8 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out):
     if margin > 0.0 and gap < margin:
         obs += 10.0 * (margin - gap) / margin
     out[0] = (f[D_WPATH] * pd + f[D_WGOAL] * left + f[D_WHEAD] * he
-              + f[D_WSPEED] * (f[D_VMAX] - v) / f[D_VMAX] + f[D_WOBS] * obs + f[D_WDYN] * dyn)
+              + f[D_WSPEED] * (f[D_VMAX] - v) / f[D_VMAX] + f[D_WOBS] * obs + f[D_WDYN] * dyn
+              + f[D_WSOC] * soc + f[D_WSIDE] * side_cost)
     if n_align > 0:
         out[0] += walign * align / n_align
     wkeep = f[D_WKEEP] if n_disc == 0 else 0.0
@@ -334,8 +389,13 @@ def _passive_penalty(gap):
 
 
 @njit(cache=True)
-def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
+def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chosen):
     """The best command from the dynamic window.
+
+    ``dside`` holds the committed passing side of each sensed disc (+1, -1, 0: none) and
+    ``chosen`` receives the best sample's ``(side, predicted gap)`` against each
+    (:mod:`pathfuse.planners.social`); the side is told against the route direction
+    ``f[D_TX], f[D_TY]`` (:func:`set_route`), or the path's at ``k`` when that is zero.
 
     ``(c0, c1)`` is the last command: ``(v, omega)`` for a diff-drive robot,
     ``(vx, vy)`` for a holonomic one.  Returns ``(a0, a1, admissible_count,
@@ -357,14 +417,14 @@ def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
             f2 = f.copy()
             f2[D_CLEAR] = hi
             a0, a1, count, best = _choose(occ, f2, x, y, th, c0, c1, pts, cum, k, dpos, dvel,
-                                          drad)
+                                          drad, dside, chosen)
             if count > 0:
                 return a0, a1, count, best
-    return _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad)
+    return _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chosen)
 
 
 @njit(cache=True)
-def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
+def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chosen):
     dt = f[D_DT]
     vmax = f[D_VMAX]
     amax = f[D_AMAX]
@@ -380,6 +440,15 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
     dspeed = np.empty(n_disc)
     for j in range(n_disc):
         dspeed[j] = math.hypot(dvel[j, 0], dvel[j, 1])
+    nd = drad.shape[0]
+    sides = np.zeros((nd, 2))
+    for j in range(nd):
+        chosen[j, 0] = 0.0
+        chosen[j, 1] = np.inf
+    tx = f[D_TX]
+    ty = f[D_TY]
+    if tx == 0.0 and ty == 0.0:
+        tx, ty = route_tangent(pts, k, th)
     if f[D_HOLO] == 1.0:
         # velocity vectors: speeds x directions (3 w_samples of them, every 8 degrees by
         # default), within |u - u0| <= a dt
@@ -404,7 +473,8 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
                             uy *= vmax / sn * (1.0 - 1e-12)
                 sp = math.hypot(ux, uy)
                 hd = math.atan2(uy, ux) if sp > 0.0 else th
-                _rollout(occ, f, x, y, hd, sp, 0.0, pts, cum, k, jg, dpos, dvel, drad, out)
+                _rollout(occ, f, x, y, hd, sp, 0.0, pts, cum, k, jg, dpos, dvel, drad, out, tx,
+                         ty, dside, sides)
                 if out[1] == 1.0 and n_disc > 0:
                     out[0] += _passive_penalty(holonomic_stop_disc_gap(
                         x, y, ux, uy, dt, amax, f[D_RADIUS], dpos, dspeed, drad))
@@ -414,6 +484,7 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
                         best = out[0]
                         b0 = ux
                         b1 = uy
+                        chosen[:, :] = sides
         if count == 0:  # nothing admissible: slow down as hard as the window allows
             sc = 0.0
             if math.isfinite(lim):
@@ -433,7 +504,8 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
                                                 whi)
             else:
                 w = min(max(0.0, wlo), whi)  # always try going straight
-            _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out)
+            _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx, ty,
+                     dside, sides)
             if out[1] == 1.0 and n_disc > 0:
                 out[0] += _passive_penalty(unicycle_stop_disc_gap(
                     x, y, th, v, w, dt, amax, f[D_ALPHA], f[D_RADIUS], dpos, dspeed, drad))
@@ -443,6 +515,7 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad):
                     best = out[0]
                     b0 = v
                     b1 = w
+                    chosen[:, :] = sides
     if count == 0:
         # nothing admissible: as slow as possible, turning towards the local goal
         err = _wrap(math.atan2(pts[jg, 1] - y, pts[jg, 0] - x) - th)

@@ -85,7 +85,12 @@ from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController, sensed_discs
-from pathfuse.planners.params import DiscParams, FieldParams, GlobalAStarParams
+from pathfuse.planners.params import (
+    DiscParams,
+    FieldParams,
+    GlobalAStarParams,
+    SocialParams,
+)
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
 from pathfuse.validate import param
@@ -99,7 +104,7 @@ FUSION_STEP_FRAC = 0.5
 
 
 @dataclass(frozen=True)
-class FusionParams(GlobalAStarParams, DiscParams, FieldParams):
+class FusionParams(GlobalAStarParams, DiscParams, FieldParams, SocialParams):
     """Parameters of the fusion planner (paper values for K_att, K_rep, rho_0).
 
     The default ``step_m`` offline is :data:`FUSION_STEP_FRAC` (0.5) x the map
@@ -125,6 +130,18 @@ class FusionParams(GlobalAStarParams, DiscParams, FieldParams):
                                             "2's move, clearance and the predicted discs "
                                             "(ours); false: the shared conversion of "
                                             "planners/drive.py")
+
+
+def _meeting_points(p: np.ndarray, v: np.ndarray, dpos: np.ndarray, dvel: np.ndarray,
+                    horizon_s: float) -> np.ndarray:
+    """Each disc's position at its time of closest approach to a robot at ``p`` moving at
+    ``v`` (both at constant velocity), that time clipped to ``[0, horizon_s]``."""
+    rel = dpos - p
+    dv = dvel - v
+    dd = np.einsum("ij,ij->i", dv, dv)
+    t = np.where(dd > 1e-12, -np.einsum("ij,ij->i", rel, dv) / np.maximum(dd, 1e-12), 0.0)
+    t = np.clip(t, 0.0, horizon_s)
+    return np.ascontiguousarray(dpos + dvel * t[:, None])
 
 
 class FusionController(FieldController):
@@ -160,7 +177,8 @@ class FusionController(FieldController):
         if self.online and rb is not None and rb.is_diff_drive and p.velocity_space:
             from pathfuse.planners.fusion_window import ForceWindow
 
-            self._window = ForceWindow(problem, float(self.dt))  # type: ignore[arg-type]
+            self._window = ForceWindow(problem, float(self.dt),  # type: ignore[arg-type]
+                                       social=p)
 
     def command(self, obs: Any) -> np.ndarray:
         """On a diff-drive robot with ``velocity_space`` (ours): Algorithm 2's move for this
@@ -189,14 +207,22 @@ class FusionController(FieldController):
     def _streamline(self, obs: Any) -> np.ndarray:
         """The robot's position and Algorithm 2's next moves from its present state (the
         move just made and up to the window's horizon of further ones, among the sensed
-        discs as they are now), without committing them: the fusion's local path."""
+        discs as they are now or, with ``social``, where each meets the robot), without
+        committing them: the fusion's local path."""
         n0 = self.n
         here = np.array([[float(obs.position[0]), float(obs.position[1])]])
         if n0 < 2 or self._window is None:
             return here
         keep = (self.buf, self.kbuf, self.state.copy(), self.buf[:n0].copy(),
                 self.kbuf[:n0].copy())
-        self._call(self._window.steps, *sensed_discs(obs))
+        dpos, dvel, drad = sensed_discs(obs)
+        if drad.shape[0] and self.params.social:
+            # ours (social): each disc where it will be at its closest approach to the
+            # robot (both at their present velocities, within the horizon), so that the
+            # local path bends around the meeting point rather than where the disc is now
+            dpos = _meeting_points(here[0], np.asarray(obs.velocity, dtype=np.float64),
+                                   dpos, dvel, self._window.horizon_s)
+        self._call(self._window.steps, dpos, dvel, drad)
         line = np.concatenate([here, self.buf[n0 - 1:self.n]])
         self.buf, self.kbuf, self.state = keep[0], keep[1], keep[2]
         self.buf[:n0] = keep[3]

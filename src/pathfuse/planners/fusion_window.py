@@ -57,8 +57,11 @@ from pathfuse.planners.dwa_kernel import (
     dwa_progress,
     pack_dwa,
     relaxed,
+    route_tangent,
     set_keep_reference,
+    set_route,
 )
+from pathfuse.planners.social import PassingSides, disc_ids
 
 __all__ = ["ForceWindow", "PASSIVE_WINDOW"]
 
@@ -83,13 +86,17 @@ class ForceWindow:
         With a diff-drive :class:`~pathfuse.robot.RobotModel`.
     dt : float
         The tick (s).
+    social : SocialParams, optional
+        The social critics among sensed moving discs (ours,
+        :mod:`pathfuse.planners.social`; default: ``dwa``'s).
     """
 
-    def __init__(self, problem: Any, dt: float) -> None:
+    def __init__(self, problem: Any, dt: float, social: Any = None) -> None:
         from pathfuse.planners.dwa import DWAParams
 
         rb = problem.robot
         p = DWAParams()
+        sp = p if social is None else social
         g = problem.grid
         self.problem = problem
         self.horizon_s = float(p.horizon_s)
@@ -104,7 +111,9 @@ class ForceWindow:
             p.obstacle_weight, p.moving_weight, p.obstacle_range_m, p.lookahead_m,
             p.inflation_decay_m, False, ox, oy, g.resolution, PASSIVE_WINDOW,
             w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
-            keep_m=p.keep_m)
+            keep_m=p.keep_m, w_social=sp.social_weight if sp.social else 0.0,
+            personal_m=sp.personal_m, w_side=sp.side_weight if sp.social else 0.0)
+        self.sides = PassingSides(sp.personal_m)
         self.steps = max(1, int(math.ceil(p.horizon_s / dt)))
         """Algorithm 2's moves looked ahead each tick (the rollouts' horizon)."""
         self.min_reach_m = 0.25 * self.steps * self.vmax * dt
@@ -214,9 +223,18 @@ class ForceWindow:
         # the field's streamline, which may graze)
         set_keep_reference(self.problem.grid.occupied, f, pts, cum,
                            min(max(int(k), 0), pts.shape[0] - 1))
+        n = drad.shape[0]
+        ids = disc_ids(obs, n)
+        chosen = np.zeros((n, 2))
+        # passing sides are told against the A* route (the local path bends around discs)
+        route = route_tangent(pts, min(max(int(k), 0), pts.shape[0] - 1), th)
+        set_route(f, route)
         a0, a1, _, _ = dwa_choose(self.problem.grid.occupied, f, x, y,
                                   float(obs.heading), float(cmd[0]), float(cmd[1]), path, pcum,
-                                  kk, dpos, dvel, drad)
+                                  kk, dpos, dvel, drad, self.sides.sides(ids), chosen)
+        if n:
+            self.sides.update(ids, chosen, dpos, (x, y), route, drad,
+                              self.problem.robot_radius_m)
         if a0 <= 0.0 and float(cmd[0]) <= 0.0 and abs(err) > 0.05:
             # the window's best is to stand and turn: turn towards the local path at the rate
             # from which the turn stops there (the window's long constant-omega rollouts

@@ -93,7 +93,7 @@ from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
 from pathfuse.planners.mppi_kernel import mppi_optimise, pack_mppi, path_inflation
-from pathfuse.planners.params import GlobalAStarParams
+from pathfuse.planners.params import GlobalAStarParams, PersonalSpaceParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
 from pathfuse.result import Status
@@ -105,7 +105,7 @@ __all__ = ["MPPIParams", "MPPIController", "clearance_field"]
 
 
 @dataclass(frozen=True)
-class MPPIParams(GlobalAStarParams):
+class MPPIParams(GlobalAStarParams, PersonalSpaceParams):
     """Parameters of ``mppi`` (the sampling, the update and the critics' weights)."""
 
     batch_size: int = param(600, ge=4, help="control sequences sampled per tick (Nav2: 1000)")
@@ -290,7 +290,8 @@ class MPPIController(Controller):
             p.prefer_forward_weight, p.vx_std_mps,
             p.vy_std_mps if self.holonomic else p.wz_std_radps, self.seg_max,
             float(problem.goal[0]), float(problem.goal[1]), p.obstacle_peak_weight,
-            g.resolution, min(vmax, p.slow_guide_speed_mps), p.keep_better_guide)
+            g.resolution, min(vmax, p.slow_guide_speed_mps), p.keep_better_guide,
+            w_social=p.social_weight if p.social else 0.0, personal_m=p.personal_m)
         self._baseline()
         n, k = int(p.time_steps), int(p.batch_size)
         self.nominal = np.zeros((n, 2))

@@ -36,8 +36,8 @@ __all__ = ["mppi_optimise", "pack_mppi", "path_inflation", "N_M", "static_gap"]
  M_OX, M_OY, M_XMAX, M_YMAX, M_FRES, M_TEMP, M_WCOLL, M_WOBS, M_INFL_R, M_INFL_K,
  M_WALIGN, M_WPROG, M_WGOAL, M_GOALD, M_WHEAD, M_LOOK, M_WDCOLL, M_WDPROX, M_DDECAY,
  M_WSMOOTH, M_WFWD, M_STD0, M_STD1, M_SEGMAX, M_GX, M_GY, M_PEAK, M_RES, M_SLOW,
- M_KEEP) = range(40)
-N_M = 40
+ M_KEEP, M_WSOC, M_PERSONAL) = range(42)
+N_M = 42
 MARGIN_COST = 1.0
 """Inside the robot's safety margin the obstacle cost grows by this much per margin width."""
 N_FIXED = 4
@@ -47,13 +47,14 @@ N_FIXED = 4
 def pack_mppi(dt, model_dt, vmin, vmax, amax, wmax, alpha, holonomic, radius, margin, ox, oy,
               xmax, ymax, field_res, temperature, w_coll, w_obs, infl_radius, infl_k, w_align,
               w_prog, w_goal, goal_dist, w_head, lookahead, w_dcoll, w_dprox, disc_decay,
-              w_smooth, w_fwd, std0, std1, seg_max, gx, gy, w_peak, res, slow, keep_guide):
+              w_smooth, w_fwd, std0, std1, seg_max, gx, gy, w_peak, res, slow, keep_guide,
+              w_social=0.0, personal_m=0.5):
     """The settings array of :func:`mppi_optimise`."""
     vals = (dt, model_dt, vmin, vmax, amax, wmax, alpha, 1.0 if holonomic else 0.0, radius,
             margin, ox, oy, xmax, ymax, field_res, temperature, w_coll, w_obs, infl_radius,
             infl_k, w_align, w_prog, w_goal, goal_dist, w_head, lookahead, w_dcoll, w_dprox,
             disc_decay, w_smooth, w_fwd, std0, std1, seg_max, gx, gy, w_peak, res, slow,
-            1.0 if keep_guide else 0.0)
+            1.0 if keep_guide else 0.0, w_social, personal_m)
     f = np.zeros(N_M)
     for i, v in enumerate(vals):
         f[i] = float(v)
@@ -315,6 +316,8 @@ def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_m
     tnow = 0.0
     hit = False
     peak = 0.0
+    # ours (pathfuse.planners.social): the least predicted gap to each disc
+    dgap = np.full(nd, np.inf)
     for t in range(n):
         h = f[M_DT] if t == 0 else f[M_MDT]
         a = seq[t, 0]
@@ -373,6 +376,8 @@ def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_m
             if l2 > 0.0:
                 u = min(1.0, max(0.0, -(ex * ddx + ey * ddy) / l2))
             g = math.hypot(ex + u * ddx, ey + u * ddy) - radius - drad[i] - dev
+            if g < dgap[i]:
+                dgap[i] = g
             if g < 0.0:
                 if tc < 0:
                     tc = t
@@ -396,6 +401,14 @@ def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_m
     if tc >= 0:
         cost += f[M_WDCOLL] * (1.0 + depth + (n - tc) / n)
     cost += f[M_WDPROX] * prox / n
+    if f[M_WSOC] > 0.0:
+        # personal space: the worst disc's shortfall, relative, squared
+        soc = 0.0
+        for i in range(nd):
+            if dgap[i] < f[M_PERSONAL]:
+                sh = (f[M_PERSONAL] - max(dgap[i], 0.0)) / f[M_PERSONAL]
+                soc = max(soc, sh * sh)
+        cost += f[M_WSOC] * soc
     if goal_mode:
         cost += f[M_WGOAL] * goal / n
     else:

@@ -169,6 +169,32 @@ class DiscParams(Checked):
                                    "move that most increases the gap (ours; false = off)")
 
 
+@dataclass(frozen=True)
+class PersonalSpaceParams(Checked):
+    """Personal space among sensed moving discs (ours; :mod:`pathfuse.planners.social`)."""
+
+    social: bool = param(True, help="social critics among sensed moving discs (ours): "
+                                    "personal space over the predicted gaps (and, in dwa and "
+                                    "the fusion, a committed passing side); false: off")
+    social_weight: float = param(20.0, ge=0, le=1e6,
+                                 help="personal-space critic: the shortfall of the least "
+                                      "predicted gap to a disc against personal_m, relative, "
+                                      "squared")
+    personal_m: float = param(0.5, gt=0, le=10, unit="m",
+                              help="personal space: the gap kept from moving discs where the "
+                                   "space allows")
+
+
+@dataclass(frozen=True)
+class SocialParams(PersonalSpaceParams):
+    """Personal space and a committed passing side (ours), for ``dwa`` and the fusion's
+    window."""
+
+    side_weight: float = param(2.0, ge=0, le=1e6,
+                               help="passing-side critic: the cost of passing a disc on the "
+                                    "other side than committed")
+
+
 _DD = " (diff-drive robot online; no effect on a holonomic robot)"
 
 

@@ -1,0 +1,126 @@
+"""Social behaviour among moving discs (ours; pathfuse.planners.social): personal space over
+the predicted gaps and a committed passing side, in dwa, the fusion's window and mppi."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pathfuse.grid import GridMap
+from pathfuse.planners import dwa_kernel as K
+from pathfuse.planners.fusion_window import ForceWindow
+from pathfuse.planners.params import SocialParams
+from pathfuse.planners.social import COMMIT_M, PassingSides
+from pathfuse.problem import Problem
+from pathfuse.robot import RobotModel
+from pathfuse.sweep import disc_sweep_gaps
+from pathfuse.world import simulate
+
+HALL = GridMap.from_rows(["." * 16] * 6)  # 16 m x 6 m, empty
+PTS = np.array([[1.0, 3.0], [15.0, 3.0]])
+CUM = np.array([0.0, 14.0])
+
+
+def _settings(**social):
+    pb = Problem.create(HALL, (1.0, 3.0), (15.0, 3.0), 0.2,
+                        robot=RobotModel.diff_drive(radius_m=0.2))
+    f = ForceWindow(pb, 0.1, social=SocialParams(**social)).f.copy()
+    K.set_route(f, (1.0, 0.0))
+    return f
+
+
+def _choose(f, disc_y, dside=0.0):
+    dpos = np.array([[7.0, disc_y]])
+    dvel = np.array([[-0.6, 0.0]])
+    drad = np.array([0.3])
+    chosen = np.zeros((1, 2))
+    a0, a1, count, _ = K.dwa_choose(HALL.occupied, f, 4.0, 3.0, 0.0, 0.8, 0.0, PTS, CUM, 0,
+                                    dpos, dvel, drad, np.array([dside]), chosen)
+    assert count > 0
+    return a0, a1, chosen[0]
+
+
+def _brute_gap(v, w, disc_y, horizon=2.5, h=0.01):
+    """The least gap of a constant (v, w) rollout from (4, 3, 0) to the disc walking at
+    -0.6 m/s from (7, disc_y), by small steps (independent of the kernel)."""
+    x, y, th = 4.0, 3.0, 0.0
+    best = np.inf
+    for i in range(int(horizon / h)):
+        t = i * h
+        q = np.array([[7.0 - 0.6 * t, disc_y]])
+        q1 = np.array([[7.0 - 0.6 * (t + h), disc_y]])
+        nx = x + v * np.cos(th) * h
+        ny = y + v * np.sin(th) * h
+        best = min(best, disc_sweep_gaps(np.array([x, y]), np.array([nx, ny]), 0.2, q, q1,
+                                         np.array([0.3]))[0])
+        x, y, th = nx, ny, th + w * h
+    return best
+
+
+def test_personal_space_widens_the_predicted_pass():
+    off = _choose(_settings(social=False), 3.1)
+    on = _choose(_settings(), 3.1)
+    g_off = _brute_gap(off[0], off[1], 3.1)
+    g_on = _brute_gap(on[0], on[1], 3.1)
+    assert g_on > g_off + 0.02  # one tick's window turns the robot only a little
+    # the kernel's predicted gap of the chosen sample agrees with the brute-force rollout
+    assert on[2][1] == pytest.approx(g_on, abs=0.03)
+
+
+def test_a_committed_side_is_kept():
+    # a disc walking dead ahead along the route: either side will do, the committed one wins
+    f = _settings()
+    for side in (1.0, -1.0):
+        assert _choose(f, 3.0, dside=side)[2][0] == side
+    # without the critic the commitment has no effect
+    f0 = _settings(side_weight=0.0)
+    assert _choose(f0, 3.0, dside=1.0)[2][0] == _choose(f0, 3.0, dside=-1.0)[2][0]
+
+
+def test_passing_sides_commit_and_release():
+    ps = PassingSides(personal_m=0.5)
+    ids = np.array([3, 8])
+    dpos = np.array([[5.0, 3.2], [9.0, 2.0]])
+    drad = np.array([0.3, 0.3])
+    # disc 3 comes close on the left: committed; disc 8 too far to be an encounter
+    chosen = np.array([[1.0, 0.2], [-1.0, 0.5 + COMMIT_M + 0.1]])
+    ps.update(ids, chosen, dpos, (4.0, 3.0), (1.0, 0.0), drad, 0.2)
+    assert ps.sides(ids).tolist() == [1.0, 0.0]
+    # a later tick whose best sample would pass on the other side does not change it
+    ps.update(ids, np.array([[-1.0, 0.1], [0.0, np.inf]]), dpos, (4.2, 3.0), (1.0, 0.0),
+              drad, 0.2)
+    assert ps.sides(ids).tolist() == [1.0, 0.0]
+    # disc 3 falls behind the robot: released; an unsensed disc is forgotten
+    ps.update(ids[:1], np.array([[1.0, 0.4]]), np.array([[3.0, 3.2]]), (4.0, 3.0), (1.0, 0.0),
+              drad[:1], 0.2)
+    assert ps.committed == {}
+
+
+HEAD_ON = Path(__file__).resolve().parents[1] / "examples" / "scenarios" / "head_on.yaml"
+
+
+@pytest.mark.parametrize("planner", ["dwa", "fusion"])
+def test_a_head_on_disc_is_passed_with_personal_space(planner):
+    # head_on.yaml: a 5 m wide hall, a disc walking head on (perturbed by the seed)
+    gaps = {soc: [simulate(HEAD_ON, planner={"name": planner, "params": {"social": soc}},
+                           seed=s, robot={"model": "diff-drive"}) for s in range(4)]
+            for soc in (True, False)}
+    for ep in gaps[True]:
+        assert ep.status.name == "SUCCESS"
+        assert ep.min_obstacle_distance_m >= 0.3
+    assert min(ep.min_obstacle_distance_m for ep in gaps[False]) < 0.3
+
+
+def test_switch_off_is_the_planner_without_the_critics():
+    sc = {"map": {"rows": ["." * 16] * 6}, "start": [1.0, 3.0], "goal": [15.0, 3.0],
+          "robot": {"radius": 0.2, "model": "diff-drive"},
+          "obstacles": [{"position": [9.0, 3.1], "velocity": [-0.6, 0.0], "radius": 0.3}]}
+    # (the fusion's social: false also drops the meeting points of its local path)
+    for name in ("dwa", "mppi"):
+        a = simulate(sc, planner={"name": name, "params": {"social": False}})
+        b = simulate(sc, planner={"name": name, "params": {"social_weight": 0.0,
+                                                           **({} if name == "mppi" else
+                                                              {"side_weight": 0.0})}})
+        np.testing.assert_array_equal(a.positions, b.positions)

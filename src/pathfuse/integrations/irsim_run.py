@@ -64,7 +64,8 @@ from pathfuse.result import ConfigError, Status
 from pathfuse.validate import short as _shown
 from pathfuse.world.social import PERSONAL_SPACE_M, SocialMetrics, social_metrics
 
-__all__ = ["WorldSpec", "read_world_spec", "perturb_env", "IrsimEpisode", "run_irsim_episode",
+__all__ = ["WorldSpec", "read_world_spec", "baseline_spec", "RvoBaselineParams", "perturb_env",
+           "IrsimEpisode", "run_irsim_episode",
            "RVO_BASELINE", "WORLD_KEYS", "PERTURB_KEYS", "DEFAULT_TIME_LIMIT_S",
            "example_worlds_dir"]
 
@@ -77,6 +78,22 @@ PERTURB_KEYS = ("position_m", "speed_frac")
 DEFAULT_TIME_LIMIT_S = 60.0
 """The time limit of a world that names none (s)."""
 _MAX_DRAWS = 50
+
+
+@dataclass(frozen=True)
+class RvoBaselineParams:
+    """IR-SIM's RVO robot takes no parameters of pathfuse's (the world file's ``behavior:``
+    block, or RVO at the robot's limits, configures it)."""
+
+
+def baseline_spec() -> Any:
+    """A :class:`~pathfuse.planners.registry.PlannerSpec` (not registered) that names
+    :data:`RVO_BASELINE` for the study engine; it has no controller: the engine's
+    ``irsim`` executor lets IR-SIM drive the robot."""
+    from pathfuse.planners.registry import PlannerSpec
+
+    return PlannerSpec(RVO_BASELINE, RvoBaselineParams,
+                       "IR-SIM's own robot, driven by its RVO behaviour (baseline)")
 
 
 @dataclass(frozen=True)
@@ -497,9 +514,10 @@ def run_irsim_episode(world: str | os.PathLike[str], planner: str = "fusion", se
         updates: list[tuple[int, np.ndarray]] = []
         if ctrl is not None and ctrl.global_path is not None:
             updates.append((0, np.asarray(ctrl.global_path, dtype=np.float64)))
+        m = n if ctrl is not None else 0  # the baseline has no adapter to time
         return IrsimEpisode(spec.name, spec.kind, name, int(seed), status, message, times,
                             pos[:n + 1].copy(), head[:n + 1].copy(), ppl[:n + 1].copy(), radii,
-                            collision_with, at_fault, soc, acts[:n].copy(), cmds[:n].copy(),
+                            collision_with, at_fault, soc, acts[:m].copy(), cmds[:m].copy(),
                             setup, unperturbed, grid, label, updates)
     finally:
         del env

@@ -18,6 +18,7 @@ from pathfuse.cli.args import (
     _positive_int,
 )
 from pathfuse.cli.barn import add_barn_parser
+from pathfuse.cli.irsim import add_irsim_parser
 from pathfuse.cli.commands import (
     cmd_bench,
     cmd_dynamic,
@@ -238,6 +239,7 @@ examples:
     dy.set_defaults(func=cmd_dynamic)
 
     add_barn_parser(sub)
+    add_irsim_parser(sub)
 
     b = sub.add_parser(
         "bench",

@@ -18,7 +18,6 @@ from pathfuse.cli.args import (
     _positive_int,
 )
 from pathfuse.cli.barn import add_barn_parser
-from pathfuse.cli.irsim import add_irsim_parser
 from pathfuse.cli.commands import (
     cmd_bench,
     cmd_dynamic,
@@ -30,6 +29,7 @@ from pathfuse.cli.commands import (
     cmd_serve,
     cmd_simulate,
 )
+from pathfuse.cli.irsim import add_irsim_parser
 from pathfuse.result import PathfuseError
 
 

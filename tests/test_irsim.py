@@ -308,3 +308,33 @@ def test_cli_irsim_errors_are_one_line(argv, message, capsys, tmp_path):
     err = capsys.readouterr().err
     assert message in err and len(err.strip().splitlines()) == 1
     assert "Traceback" not in err
+
+
+def test_experiment_irsim_entries_key_by_contents_and_name_bad_keys(tmp_path):
+    import shutil
+
+    from pathfuse.bench.experiment import experiment_from_dict
+
+    shutil.copy(EXAMPLES / "doorway.yaml", tmp_path / "door.yaml")
+    doc = {"seeds": 2, "maps": [{"irsim": "door.yaml"}],
+           "planners": [{"name": "fusion", "kinds": ["irsim"]},
+                        {"name": RVO_BASELINE, "kinds": ["irsim"]}]}
+    runs = experiment_from_dict(doc, tmp_path / "e.yaml").expand()
+    assert [(r.kind, r.group, r.planner, r.seed) for r in runs] == [
+        ("irsim", "door", "fusion", 0), ("irsim", "door", RVO_BASELINE, 0),
+        ("irsim", "door", "fusion", 1), ("irsim", "door", RVO_BASELINE, 1)]
+    (tmp_path / "door.yaml").write_text((EXAMPLES / "doorway.yaml").read_text()
+                                        .replace("time_limit_s: 50", "time_limit_s: 45"))
+    again = experiment_from_dict(doc, tmp_path / "e.yaml").expand()
+    assert {r.key for r in runs}.isdisjoint(r.key for r in again)  # the file's contents
+    for maps, planners, msg in [
+        ([{"irsim": "nope.yaml"}], [{"name": "fusion"}], r"maps\[0\]\.irsim: no such"),
+        ([{"irsim": {"world": "door.yaml", "resolution_m": 0}}], [{"name": "fusion"}],
+         r"maps\[0\]\.irsim\.resolution_m"),
+        ([{"irsim": "door.yaml", "start": [0, 0]}], [{"name": "fusion"}],
+         r"maps\[0\]\.start: not used with irsim"),
+        ([{"irsim": "door.yaml"}], [{"name": RVO_BASELINE, "params": {"k": 1}}],
+         r"planners\[0\]\.params\.k"),
+    ]:
+        with pytest.raises(ConfigError, match=msg):
+            experiment_from_dict({"maps": maps, "planners": planners}, tmp_path / "e.yaml")

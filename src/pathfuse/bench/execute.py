@@ -546,8 +546,8 @@ def _clearance_at(sc: Any, x: float, y: float, discs: np.ndarray | None,
 def run_irsim(group: Mapping[str, Any], run: Mapping[str, Any],
               store_paths: bool) -> dict[str, Any]:
     """One episode in an IR-SIM world (the ``"irsim"`` kind; needs ``pathfuse[irsim]``):
-    :func:`pathfuse.studies.irsim.irsim_row`."""
-    from pathfuse.studies.irsim import irsim_row
+    :func:`pathfuse.integrations.irsim_run.irsim_row`."""
+    from pathfuse.integrations.irsim_run import irsim_row
 
     return irsim_row(group, run, store_paths)
 

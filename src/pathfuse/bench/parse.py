@@ -31,6 +31,7 @@ from pathfuse.bench.keys import (
     canonical_json,
     parse_seeds,
 )
+from pathfuse.bench.kind_irsim import external_names, external_spec, parse_irsim_entry
 from pathfuse.bench.spec import (
     Experiment,
     MapEntry,
@@ -162,8 +163,8 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
     maps = []
     names: dict[str, int] = {}
     for i, v in enumerate(raw_maps):
-        entry = _parse_map(i, v, top_seeds, radius, exp_dir,
-                           seeds_override is not None)
+        entry = (parse_irsim_entry if isinstance(v, Mapping) and "irsim" in v else _parse_map)(
+            i, v, top_seeds, radius, exp_dir, seeds_override is not None)
         if entry.name in names:
             raise ConfigError(f"maps[{i}].name: {_shown(entry.name)} is already the name of "
                               f"maps[{names[entry.name]}]")
@@ -190,14 +191,6 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
             if entry.kind == "static" and entry.scen is None:
                 grid = _load_for_expand(exp, entry, f"maps[{entry.index}]")
                 _check_queries(entry, grid)
-            elif entry.kind == "irsim":
-                from pathfuse.integrations.irsim_run import read_world_spec
-
-                _, load, _ = exp._map_identity(entry, entry.seeds[0])
-                try:
-                    read_world_spec(load["irsim"]["world"])
-                except PathfuseError as exc:
-                    raise ConfigError(f"maps[{entry.index}].irsim: {exc}") from None
             elif entry.kind == "dynamic":
                 _, load, _ = exp._map_identity(entry, entry.seeds[0])
                 try:
@@ -254,33 +247,21 @@ class _Registry:
         from pathfuse.planners.registry import REGISTRY, planner_names
 
         names = planner_names()
-        if self.kind == "irsim":  # IR-SIM's own robot beside pathfuse's online planners
-            from pathfuse.integrations.irsim_run import RVO_BASELINE
-
-            return [n for n in names if REGISTRY[n].online] + [RVO_BASELINE]
-        return names if self.kind == "static" else [n for n in names if REGISTRY[n].online]
+        return names if self.kind == "static" else \
+            [n for n in names if REGISTRY[n].online] + external_names(self.kind)
 
     def get(self, name: Any) -> Any:
         from pathfuse.planners.registry import get_planner
 
-        if self.kind == "irsim":
-            from pathfuse.integrations.irsim_run import RVO_BASELINE, baseline_spec
-
-            if name == RVO_BASELINE:
-                return baseline_spec()
-        spec = get_planner(name)
-        if self.kind != "static" and not spec.online:
+        spec = external_spec(self.kind, name) or get_planner(name)
+        if self.kind == "dynamic" and not spec.online:
             raise ConfigError(f"planner {_shown(spec.name)} only plans offline; it cannot run on a "
-                              f"{self.kind} entry")
+                              "dynamic entry")
         return spec
 
     def make(self, spec: Any, params: Mapping[str, Any]) -> Any:
         from pathfuse.planners.registry import make_params
 
-        if spec.controller is None and spec.function is None:  # IR-SIM's robot
-            from pathfuse.validate import build
-
-            return build(spec.params_cls, dict(params), "params", ConfigError)
         return make_params(spec, dict(params), key="params")
 
 
@@ -414,8 +395,6 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
     seeds = top_seeds if seeds_overridden or "seeds" not in v else \
         parse_seeds(v["seeds"], f"{where}.seeds")
     radius = _radius(v.get("robot_radius_m", top_radius), f"{where}.robot_radius_m")
-    if "irsim" in v:
-        return _parse_irsim(i, v, seeds, radius, exp_dir, where)
     if "dynamic" in v:
         extra = set(v) - {"name", "dynamic", "seeds", "robot_radius_m"}
         if extra:
@@ -518,42 +497,6 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                     seeds=seeds, robot_radius_m=radius, queries=tuple(queries),
                     random_queries=random_q, scen=scen, lines=v.get("lines"),
                     pair_keys="start" in v or "goal" in v)
-
-
-def _parse_irsim(i: int, v: Mapping[str, Any], seeds: tuple[int, ...], radius: float,
-                 exp_dir: Path, where: str) -> MapEntry:
-    """An ``irsim:`` entry: an IR-SIM world file, or ``{world: FILE, resolution_m: R,
-    time_limit_s: T}`` (the resolution its static obstacles are rasterised at, default
-    0.05 m; a time limit instead of the world's)."""
-    extra = set(v) - {"name", "irsim", "seeds"}
-    if extra:
-        raise ConfigError(f"{where}.{sorted(extra)[0]}: not used with irsim "
-                          "(the world file holds the map, the robot and its goal)")
-    w = v["irsim"]
-    if isinstance(w, str):
-        w = {"world": w}
-    if not isinstance(w, Mapping) or not isinstance(w.get("world"), str) \
-            or set(w) - {"world", "resolution_m", "time_limit_s"}:
-        raise ConfigError(f"{where}.irsim: expected an IR-SIM world file or {{world: FILE, "
-                          f"resolution_m: R, time_limit_s: T}}, got {_short(w)}")
-    wp = Path(os.path.expanduser(w["world"]))
-    wp = wp if wp.is_absolute() else exp_dir / wp
-    if not wp.is_file():
-        raise ConfigError(f"{where}.irsim: no such IR-SIM world file {wp}")
-    res = w.get("resolution_m", 0.05)
-    if not _is_num(res) or float(res) <= 0:
-        raise ConfigError(f"{where}.irsim.resolution_m: must be a number > 0 (metres), "
-                          f"got {_shown(res)}")
-    spec: dict[str, Any] = {"world": w["world"], "resolution_m": float(res)}
-    if w.get("time_limit_s") is not None:
-        t = w["time_limit_s"]
-        if not _is_num(t) or float(t) <= 0:
-            raise ConfigError(f"{where}.irsim.time_limit_s: must be a number > 0 (seconds), "
-                              f"got {_shown(t)}")
-        spec["time_limit_s"] = float(t)
-    name = _entry_name(v, where, Path(w["world"]).stem)
-    return MapEntry(index=i, name=name, kind="irsim", spec=None, family=None, seeds=seeds,
-                    robot_radius_m=radius, dynamic=spec)
 
 
 def _check_generate(dyn: Mapping[str, Any], where: str) -> None:

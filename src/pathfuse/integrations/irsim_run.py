@@ -41,6 +41,7 @@ Examples
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import time
@@ -64,7 +65,8 @@ from pathfuse.result import ConfigError, Status
 from pathfuse.validate import short as _shown
 from pathfuse.world.social import PERSONAL_SPACE_M, SocialMetrics, social_metrics
 
-__all__ = ["WorldSpec", "read_world_spec", "baseline_spec", "RvoBaselineParams", "perturb_env",
+__all__ = ["irsim_row", "WorldSpec", "read_world_spec", "baseline_spec", "RvoBaselineParams",
+           "perturb_env",
            "IrsimEpisode", "run_irsim_episode",
            "RVO_BASELINE", "WORLD_KEYS", "PERTURB_KEYS", "DEFAULT_TIME_LIMIT_S",
            "example_worlds_dir"]
@@ -521,3 +523,62 @@ def run_irsim_episode(world: str | os.PathLike[str], planner: str = "fusion", se
                             setup, unperturbed, grid, label, updates)
     finally:
         del env
+
+
+_TIMING = ("mean_act_time_s", "median_act_time_s", "median_command_time_s", "setup_time_s")
+
+
+def _json_params(planner: str, params: Mapping[str, Any]) -> dict[str, Any]:
+    """Parameters read back from a run's JSON: lists to tuples where the default is a
+    tuple."""
+    from pathfuse.planners.registry import get_planner
+
+    defaults = get_planner(planner).defaults()
+    return {k: tuple(v) if isinstance(defaults.get(k), tuple) and isinstance(v, list) else v
+            for k, v in params.items()}
+
+
+def irsim_row(group: Mapping[str, Any], run: Mapping[str, Any],
+              store_paths: bool) -> dict[str, Any]:
+    """One run of the study engine's ``irsim`` kind (:mod:`pathfuse.bench.execute`): the
+    episode as result columns.
+
+    ``time`` is the adapter's compute time (setup plus every step's ``act``);
+    ``solution_clearance`` the minimum gap to the people; ``collisions`` 1 when IR-SIM
+    ended the episode in a collision; ``metrics`` every value of
+    :meth:`~pathfuse.integrations.irsim_run.IrsimEpisode.metrics` but the timings, which
+    go to ``timing``.
+    """
+    w = group["map_spec"]["irsim"]
+    planner = run["planner"]
+    params = {} if planner == RVO_BASELINE else _json_params(planner, run["params"] or {})
+    limit = w.get("time_limit_s")
+    ep = run_irsim_episode(w["world"], planner, int(run["seed"]), params or None,
+                           resolution_m=float(w.get("resolution_m", 0.05)),
+                           time_limit_s=None if limit is None else float(limit))
+    m = ep.metrics()
+    timing = {k: m.pop(k) for k in _TIMING}
+    solved = ep.reached
+    row: dict[str, Any] = {
+        "status_name": ep.status.name,
+        "solved": solved,
+        "time": float(ep.setup_time_s + ep.act_times_s.sum()),
+        "solution_length": ep.path_length_m if solved else None,
+        "time_to_goal": ep.time_to_goal_s,
+        "path_length": ep.path_length_m,
+        "collisions": 1 if m["collision"] else 0,
+        "collision_free": not m["collision"],
+        "iterations": ep.n_ticks,
+        "steps": ep.n_ticks,
+        "solution_segments": ep.n_ticks if solved else None,
+        "solution_clearance": m["min_gap_m"],
+        "message": ep.message,
+        "start_x": float(ep.positions[0, 0]), "start_y": float(ep.positions[0, 1]),
+        "goal_x": float(ep.scenario.goal[0]), "goal_y": float(ep.scenario.goal[1]),
+        "metrics": json.dumps(m, sort_keys=True),
+        "timing": json.dumps(timing, sort_keys=True),
+    }
+    if store_paths:
+        row["path"] = np.ascontiguousarray(ep.positions, dtype="<f8").tobytes()
+        row["headings"] = np.ascontiguousarray(ep.headings, dtype="<f8").tobytes()
+    return row

@@ -42,13 +42,12 @@ import numpy as np
 from pathfuse.result import ConfigError
 from pathfuse.validate import short as _shown
 
-__all__ = ["IrsimConfig", "IrsimRun", "irsim_row", "irsim_experiment", "run_irsim_study",
+__all__ = ["IrsimConfig", "IrsimRun", "irsim_experiment", "run_irsim_study",
            "summary_rows", "text_table", "markdown_report", "write_irsim_outputs",
            "find_world_files", "DEFAULT_SEEDS", "write_gifs"]
 
 DEFAULT_SEEDS = 8
 """Seeds per world by default."""
-_TIMING = ("mean_act_time_s", "median_act_time_s", "median_command_time_s", "setup_time_s")
 
 
 def find_world_files(paths: Sequence[str | os.PathLike[str]]) -> tuple[str, ...]:
@@ -177,54 +176,6 @@ class IrsimRun:
 
 
 # --------------------------------------------------------------------------- engine
-def irsim_row(group: Mapping[str, Any], run: Mapping[str, Any],
-              store_paths: bool) -> dict[str, Any]:
-    """One run of the engine's ``irsim`` kind: the episode as result columns.
-
-    ``time`` is the adapter's compute time (setup plus every step's ``act``);
-    ``solution_clearance`` the minimum gap to the people; ``collisions`` 1 when IR-SIM
-    ended the episode in a collision; ``metrics`` every value of
-    :meth:`~pathfuse.integrations.irsim_run.IrsimEpisode.metrics` but the timings, which
-    go to ``timing``.
-    """
-    from pathfuse.bench.execute import _path_blob, _plan_params
-    from pathfuse.integrations.irsim_run import RVO_BASELINE, run_irsim_episode
-
-    w = group["map_spec"]["irsim"]
-    planner = run["planner"]
-    params = {} if planner == RVO_BASELINE else _plan_params(planner, run["params"] or {})
-    limit = w.get("time_limit_s")
-    ep = run_irsim_episode(w["world"], planner, int(run["seed"]), params or None,
-                           resolution_m=float(w.get("resolution_m", 0.05)),
-                           time_limit_s=None if limit is None else float(limit))
-    m = ep.metrics()
-    timing = {k: m.pop(k) for k in _TIMING}
-    solved = ep.reached
-    row: dict[str, Any] = {
-        "status_name": ep.status.name,
-        "solved": solved,
-        "time": float(ep.setup_time_s + ep.act_times_s.sum()),
-        "solution_length": ep.path_length_m if solved else None,
-        "time_to_goal": ep.time_to_goal_s,
-        "path_length": ep.path_length_m,
-        "collisions": 1 if m["collision"] else 0,
-        "collision_free": not m["collision"],
-        "iterations": ep.n_ticks,
-        "steps": ep.n_ticks,
-        "solution_segments": ep.n_ticks if solved else None,
-        "solution_clearance": m["min_gap_m"],
-        "message": ep.message,
-        "start_x": float(ep.positions[0, 0]), "start_y": float(ep.positions[0, 1]),
-        "goal_x": float(ep.scenario.goal[0]), "goal_y": float(ep.scenario.goal[1]),
-        "metrics": json.dumps(m, sort_keys=True),
-        "timing": json.dumps(timing, sort_keys=True),
-    }
-    if store_paths:
-        row["path"] = _path_blob(ep.positions)
-        row["headings"] = np.ascontiguousarray(ep.headings, dtype="<f8").tobytes()
-    return row
-
-
 def irsim_experiment(cfg: IrsimConfig) -> Any:
     """The study engine's experiment: one ``irsim`` map entry per world (named by its file's
     stem), every planner, seeds ``0 .. n_seeds - 1``."""

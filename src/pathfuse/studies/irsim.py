@@ -413,16 +413,23 @@ def write_irsim_outputs(run: IrsimRun, out_dir: str | os.PathLike[str]) -> dict[
 def write_gifs(config: IrsimConfig, out_dir: str | os.PathLike[str], seed: int = 0
                ) -> list[Path]:
     """One GIF per (world, planner) of seed ``seed`` in ``out_dir/gifs`` (the episode run
-    again: it is the same episode, see :mod:`pathfuse.integrations.irsim_run`)."""
+    again: it is the same episode, see :mod:`pathfuse.integrations.irsim_run`; a planner
+    with a ``seed`` parameter gets the run's seed, as the study engine gives it)."""
     from pathfuse.integrations.irsim_run import run_irsim_episode
     from pathfuse.viz.animate import animate_episode
 
     folder = Path(out_dir) / "gifs"
     folder.mkdir(parents=True, exist_ok=True)
     out = []
+    from pathfuse.integrations.irsim_run import RVO_BASELINE
+    from pathfuse.planners.registry import get_planner
+
     for w in config.worlds:
         for p in config.planners:
-            ep = run_irsim_episode(w, p, seed, config.params.get(p) or None,
+            params = dict(config.params.get(p) or {})
+            if p != RVO_BASELINE and "seed" in get_planner(p).defaults():
+                params.setdefault("seed", seed)  # as the study engine gives it (mppi)
+            ep = run_irsim_episode(w, p, seed, params or None,
                                    resolution_m=config.resolution_m,
                                    time_limit_s=config.time_limit_s)
             f = folder / f"{Path(w).stem}_{p}_seed{seed}.gif"

@@ -22,6 +22,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("search", "field", "io", "generate", "metrics", "metrics_kernels"),
     ("planners", "api"),
     ("world",),
+    ("integrations",),
     ("viz",),
     ("bench",),
     ("studies",),

@@ -11,7 +11,8 @@ worker that gets many batches on the same map loads it once.
 
 The run **kind** selects the executor (:data:`KINDS`): ``"static"`` plans with
 :func:`pathfuse.plan` on a map; ``"dynamic"`` runs an episode with
-:func:`pathfuse.world.simulate`.  A run that raises becomes a row with
+:func:`pathfuse.world.simulate`; ``"irsim"`` runs an episode in an IR-SIM world
+(:mod:`pathfuse.integrations.irsim_run`).  A run that raises becomes a row with
 ``status_name = "ERROR"`` and the error text; it never stops the batch.
 """
 
@@ -542,8 +543,23 @@ def _clearance_at(sc: Any, x: float, y: float, discs: np.ndarray | None,
     return gap
 
 
+def run_irsim(group: Mapping[str, Any], run: Mapping[str, Any],
+              store_paths: bool) -> dict[str, Any]:
+    """One episode in an IR-SIM world (the ``"irsim"`` kind; needs ``pathfuse[irsim]``):
+    :func:`pathfuse.integrations.irsim_run.irsim_row`."""
+    from pathfuse.integrations.irsim_run import irsim_row
+
+    return irsim_row(group, run, store_paths)
+
+
 KINDS: dict[str, Callable[[Mapping[str, Any], Mapping[str, Any], bool], dict[str, Any]]] = {
     "static": run_static,
     "dynamic": run_dynamic,
+    "irsim": run_irsim,
 }
 """Run kind -> executor.  Register a new kind here (it gets its own rows)."""
+
+EXTERNAL_PLANNERS: dict[str, tuple[str, ...]] = {"irsim": ("irsim-rvo",)}
+"""Run kind -> the planner names its executor runs itself, outside pathfuse's registry
+(IR-SIM's own RVO robot, :data:`pathfuse.integrations.irsim_run.RVO_BASELINE`): no
+kernels to warm."""

@@ -38,7 +38,7 @@ ALL_FAMILIES = GENERATED_FAMILIES + FILE_FAMILIES + INLINE_FAMILIES
 _TOP_KEYS = ("name", "description", "seeds", "limits", "robot_radius_m", "reference",
              "store_paths", "imports", "maps", "planners")
 _MAP_KEYS = ("name", "map", "start", "goal", "queries", "scen", "lines", "seeds",
-             "robot_radius_m", "dynamic")
+             "robot_radius_m", "dynamic", "irsim")
 _PLANNER_KEYS = ("name", "label", "params", "limits", "kinds")
 _LIMIT_KEYS = ("time_limit_s", "max_iterations")
 

@@ -31,6 +31,7 @@ from pathfuse.bench.keys import (
     canonical_json,
     parse_seeds,
 )
+from pathfuse.bench.kind_irsim import external_names, external_spec, parse_irsim_entry
 from pathfuse.bench.spec import (
     Experiment,
     MapEntry,
@@ -162,14 +163,14 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
     maps = []
     names: dict[str, int] = {}
     for i, v in enumerate(raw_maps):
-        entry = _parse_map(i, v, top_seeds, radius, exp_dir,
-                           seeds_override is not None)
+        entry = (parse_irsim_entry if isinstance(v, Mapping) and "irsim" in v else _parse_map)(
+            i, v, top_seeds, radius, exp_dir, seeds_override is not None)
         if entry.name in names:
             raise ConfigError(f"maps[{i}].name: {_shown(entry.name)} is already the name of "
                               f"maps[{names[entry.name]}]")
         names[entry.name] = i
         maps.append(entry)
-    kinds = tuple(k for k in ("static", "dynamic") if any(m.kind == k for m in maps))
+    kinds = tuple(k for k in ("static", "dynamic", "irsim") if any(m.kind == k for m in maps))
     raw_planners = doc.get("planners")
     if not isinstance(raw_planners, list) or not raw_planners:
         raise ConfigError("planners: must be a non-empty list of planners")
@@ -178,7 +179,7 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
         if not any(m.kind in p.kinds for p in planners):
             raise ConfigError(f"maps[{m.index}]: no planner of this experiment runs "
                               f"{m.kind} maps (" + ("planners that run online: "
-                              + ", ".join(_registry("dynamic").names()) if m.kind == "dynamic"
+                              + ", ".join(_registry(m.kind).names()) if m.kind != "static"
                               else "planners: " + ", ".join(_registry("static").names()))
                               + ")")
     exp = Experiment(path=path, name=name.strip(), description=desc, text=text,
@@ -246,12 +247,13 @@ class _Registry:
         from pathfuse.planners.registry import REGISTRY, planner_names
 
         names = planner_names()
-        return names if self.kind == "static" else [n for n in names if REGISTRY[n].online]
+        return names if self.kind == "static" else \
+            [n for n in names if REGISTRY[n].online] + external_names(self.kind)
 
     def get(self, name: Any) -> Any:
         from pathfuse.planners.registry import get_planner
 
-        spec = get_planner(name)
+        spec = external_spec(self.kind, name) or get_planner(name)
         if self.kind == "dynamic" and not spec.online:
             raise ConfigError(f"planner {_shown(spec.name)} only plans offline; it cannot run on a "
                               "dynamic entry")
@@ -291,8 +293,8 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         want = v["kinds"]
         want = [want] if isinstance(want, str) else want
         if not isinstance(want, list) or not want or \
-                not set(want) <= {"static", "dynamic"}:
-            raise ConfigError(f"{where}.kinds: expected a list of static / dynamic, "
+                not set(want) <= {"static", "dynamic", "irsim"}:
+            raise ConfigError(f"{where}.kinds: expected a list of static / dynamic / irsim, "
                               f"got {_short(v['kinds'])}")
         kinds = [k for k in kinds if k in want]
     specs: dict[str, Any] = {}

@@ -371,8 +371,12 @@ def _run_locked(exp: Experiment, runs: list[RunSpec], store: ResultStore, own_st
         try:
             if todo and scheduler is None:  # compile once here; workers load from the cache
                 tw = time.perf_counter()
-                warm_kernels([r.planner for r in todo], metrics=True,
-                             world=any(r.kind == "dynamic" for r in todo),
+                from pathfuse.bench.execute import EXTERNAL_PLANNERS
+
+                warm_kernels([r.planner for r in todo
+                              if r.planner not in EXTERNAL_PLANNERS.get(r.kind, ())],
+                             metrics=True,
+                             world=any(r.kind in ("dynamic", "irsim") for r in todo),
                              notify=bar.notice if enabled else None)
                 summary.compile_s = time.perf_counter() - tw
                 bar.start()

@@ -95,7 +95,7 @@ class MapEntry:
 
     index: int
     name: str
-    kind: str  # "static" or "dynamic"
+    kind: str  # "static", "dynamic" or "irsim"
     spec: dict[str, Any] | None  # the map spec as written (static)
     family: str | None
     seeds: tuple[int, ...]
@@ -272,6 +272,12 @@ class Experiment:
     # -- map identity ------------------------------------------------------
     def _map_identity(self, entry: MapEntry, seed: int) -> tuple[Any, Any, str]:
         """(portable spec for the key, loadable spec, cache key) of entry's map for seed."""
+        if entry.kind == "irsim":  # an IR-SIM world file: its contents are its identity
+            w = entry.dynamic
+            p = self.resolve(w["world"])
+            portable_w: dict[str, Any] = {"irsim": {**w, "sha256": file_digest(p)}}
+            load_w: dict[str, Any] = {"irsim": {**w, "world": str(p.resolve())}}
+            return portable_w, load_w, run_key(portable_w)[:24]
         if entry.kind == "dynamic":
             dyn = entry.dynamic
             if isinstance(dyn, str):
@@ -303,7 +309,7 @@ class Experiment:
 
     # -- queries -------------------------------------------------------------
     def _queries(self, entry: MapEntry, seed: int) -> list[dict[str, Any]]:
-        if entry.kind == "dynamic":
+        if entry.kind in ("dynamic", "irsim"):
             return [{}]
         if entry.scen is not None:
             return list(self._scen_queries(entry))

@@ -29,6 +29,7 @@ from pathfuse.cli.commands import (
     cmd_serve,
     cmd_simulate,
 )
+from pathfuse.cli.irsim import add_irsim_parser
 from pathfuse.result import PathfuseError
 
 
@@ -240,6 +241,7 @@ examples:
     dy.set_defaults(func=cmd_dynamic)
 
     add_barn_parser(sub)
+    add_irsim_parser(sub)
 
     b = sub.add_parser(
         "bench",

@@ -161,6 +161,20 @@ class Episode:
         return self.status is Status.SUCCESS
 
     @property
+    def social(self) -> Any:
+        """The social metrics of the run with the moving discs as the people
+        (:func:`pathfuse.world.social.social_metrics`: minimum gap, time within 0.45 m,
+        contacts the robot drove into, path irregularity); None without discs."""
+        if not self.obstacle_radii.size:
+            return None
+        from pathfuse.world.social import social_metrics
+
+        heads = self.headings if self.robot.is_diff_drive and \
+            self.headings.shape[0] == self.positions.shape[0] else None
+        return social_metrics(self.positions, self.obstacle_positions, self.obstacle_radii,
+                              self.robot_radius, float(self.scenario.dt), headings=heads)
+
+    @property
     def mean_plan_time_s(self) -> float:
         """Mean wall-clock planning time per tick (0 without ticks)."""
         return float(self.plan_times_s.mean()) if self.plan_times_s.size else 0.0
@@ -210,6 +224,10 @@ class Episode:
             "setup_time_s": float(self.setup_time_s),
             "robot_model": self.scenario.robot.model,
         }
+        soc = self.social
+        if soc is not None:  # among moving discs: the social metrics (pathfuse.world.social)
+            d.update({k: fin(v) if isinstance(v, float) else v
+                      for k, v in soc.as_dict().items()})
         if trajectories:
             d["times"] = self.times.tolist()
             d["positions"] = self.positions.tolist()

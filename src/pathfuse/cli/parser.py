@@ -29,6 +29,7 @@ from pathfuse.cli.commands import (
     cmd_serve,
     cmd_simulate,
 )
+from pathfuse.cli.shipped import add_data_parser, add_examples_parser
 from pathfuse.result import PathfuseError
 
 
@@ -157,6 +158,7 @@ examples:
         epilog=_fmt("""
 examples:
   pathfuse simulate examples/scenarios/head_on.yaml
+  pathfuse simulate head_on --planner fusion
   pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
   pathfuse simulate examples/scenarios/corridor_crowd.yaml --planner dwa --robot model=diff-drive
   pathfuse simulate examples/scenarios/crossing.yaml --planner fusion --param repulsion=velocity
@@ -170,7 +172,8 @@ an animation plays in real time unless that takes more than 150 frames, then fas
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    sm.add_argument("scenario", help="scenario YAML file")
+    sm.add_argument("scenario", help="scenario YAML file, or the name of a shipped one "
+                    "('pathfuse examples' lists them)")
     sm.add_argument("--planner", help="planner (default: the scenario's)")
     sm.add_argument("--param", action="append", metavar="KEY=VALUE",
                     help="planner parameter, repeatable (e.g. --param repulsion=velocity)")
@@ -238,6 +241,8 @@ examples:
     dy.set_defaults(func=cmd_dynamic)
 
     add_barn_parser(sub)
+    add_examples_parser(sub)
+    add_data_parser(sub)
 
     b = sub.add_parser(
         "bench",
@@ -263,7 +268,8 @@ See experiments/*.yaml for the file format (maps, seeds, planners, swept paramet
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    b.add_argument("experiment", help="experiment YAML file")
+    b.add_argument("experiment", help="experiment YAML file, or the name of a shipped one "
+                   "('pathfuse examples' lists them)")
     b.add_argument("--db", required=True, metavar="STUDY.db",
                    help="SQLite study database (created if missing, resumed if not)")
     b.add_argument("--seeds", metavar="N|A:B|A,B,..",

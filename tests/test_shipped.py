@@ -106,9 +106,12 @@ def test_a_wheel_installed_outside_the_clone_runs_the_shipped_examples(tmp_path)
     """Build the wheel, install it (no dependencies) into a fresh venv that sees this
     environment's numpy, numba, ... through a .pth line (so the installed pathfuse is the
     wheel's, not this clone's), and run the two commands from a temporary folder."""
+    # no PYTHONPATH anywhere: a source tree on it (with the egg-info a build leaves there)
+    # would count as an installed pathfuse, and pip would then skip the wheel
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "NUMBA_CACHE_DIR")}
     wheels = tmp_path / "wheels"
     b = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps", "-q",
-                        "-w", str(wheels)], capture_output=True, text=True, timeout=600)
+                        "-w", str(wheels)], capture_output=True, text=True, timeout=600, env=env)
     assert b.returncode == 0, b.stderr
     (whl,) = wheels.glob("pathfuse-*.whl")
     names = zipfile.ZipFile(whl).namelist()
@@ -119,19 +122,19 @@ def test_a_wheel_installed_outside_the_clone_runs_the_shipped_examples(tmp_path)
         assert want in names, want
     assert not any(n.startswith("tests/") or "/tests/test_" in n for n in names)
     venv = tmp_path / "venv"
-    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, timeout=300)
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, timeout=300, env=env)
     py = venv / "bin" / "python"
     i = subprocess.run([str(py), "-m", "pip", "install", "-q", "--no-deps", "--no-index",
-                        str(whl)], capture_output=True, text=True, timeout=300)
+                        str(whl)], capture_output=True, text=True, timeout=300, env=env)
     assert i.returncode == 0, i.stderr
     site = subprocess.run([str(py), "-c", "import sysconfig; print(sysconfig.get_paths()"
-                           "['purelib'])"], capture_output=True, text=True, check=True).stdout
+                           "['purelib'])"], capture_output=True, text=True, check=True,
+                          env=env).stdout
     # then this environment's dependencies, as plain path entries after the venv's own (its
     # .pth files, among them an editable pathfuse's hook, are not run from there)
     Path(site.strip(), "deps.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     run_dir = tmp_path / "elsewhere"
     run_dir.mkdir()
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "NUMBA_CACHE_DIR")}
     where = subprocess.run([str(py), "-c", "import pathfuse; print(pathfuse.__file__)"],
                            capture_output=True, text=True, cwd=run_dir, env=env)
     assert where.stdout.strip().startswith(str(venv)), where.stderr

@@ -364,7 +364,8 @@ def _add_serve(sub: argparse._SubParsersAction) -> None:
         description="Start a local web app: draw or load a map, drag start and goal, run "
         "any registered planners side by side, look at the potential field, the A* closed "
         "set and the c-space, and play moving-obstacle episodes.  Its JSON API is "
-        "documented in the README.  Binds to 127.0.0.1 unless --host says otherwise, and "
+        "documented in docs/guide/playground.md.  Binds to 127.0.0.1 unless --host says "
+        "otherwise, and "
         "answers requests that name a loopback host (localhost, 127.0.0.1, ::1) unless "
         "--allow-host adds names.  Every computation runs in a worker process that is "
         "stopped at the --budget.",

@@ -68,12 +68,15 @@ def test_there_are_python_examples_to_run():
 
 
 def test_every_python_example_of_the_readme_and_the_docs_runs(tmp_path):
-    """All blocks in one child process (the kernels compile once), each in a fresh
-    namespace, from the repository's root (the examples' paths are those of a clone)."""
-    script = ["import traceback, sys", "failed = []"]
+    """All blocks in one child process (the kernels compile once), the blocks of a page
+    in sequence in one namespace (as a reader runs them), from the repository's root (the
+    examples' paths are those of a clone)."""
+    script = ["import traceback, sys", "failed = []", "pages = {}"]
     for path, i, code in BLOCKS:
         name = f"{path.relative_to(ROOT)}[{i}]"
-        script += [f"try:\n    exec(compile({code!r}, {name!r}, 'exec'), {{}})",
+        page = str(path.relative_to(ROOT))
+        script += [f"try:\n    exec(compile({code!r}, {name!r}, 'exec'), "
+                   f"pages.setdefault({page!r}, {{}}))",
                    f"except Exception:\n    failed.append({name!r}); traceback.print_exc()"]
     script += ["print('FAILED', failed) if failed else print('OK')",
                "sys.exit(1 if failed else 0)"]

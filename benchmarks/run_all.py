@@ -45,7 +45,7 @@ from typing import Any
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 RESULTS = HERE / "results"
-README = ROOT / "docs" / "speed.md"  # the speed page (the README links to it)
+SPEED_PAGE = ROOT / "docs" / "speed.md"  # the speed page (the README links to it)
 BLOCKS = ("search", "peers", "plan", "startup", "stepping")
 
 
@@ -259,7 +259,7 @@ def rewrite(text: str, names: list[str]) -> str:
     for name in names:
         pat = _pattern(name)
         if not pat.search(text):
-            raise SystemExit(f"{README.name} has no block speed:{name}")
+            raise SystemExit(f"{SPEED_PAGE.name} has no block speed:{name}")
         body = render(name)
         text = pat.sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
     return text
@@ -300,7 +300,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--check", action="store_true",
                     help="exit 1 when a block of docs/speed.md differs from its JSON")
     args = ap.parse_args(argv)
-    text = README.read_text()
+    text = SPEED_PAGE.read_text()
     if args.check:
         bad = [n for n, body in blocks_in(text).items() if body != render(n)]
         print("stale blocks: " + ", ".join(bad) if bad else "every block is up to date")
@@ -308,8 +308,8 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_run:
         for name in args.only:
             run(name)
-    README.write_text(rewrite(README.read_text(), args.only))
-    print(f"\nrewrote the blocks {', '.join(args.only)} of {README}")
+    SPEED_PAGE.write_text(rewrite(SPEED_PAGE.read_text(), args.only))
+    print(f"\nrewrote the blocks {', '.join(args.only)} of {SPEED_PAGE}")
     return 0
 
 

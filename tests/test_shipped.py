@@ -71,7 +71,7 @@ def test_copy_writes_a_clone_layout_and_never_overwrites(tmp_path):
 
 def test_the_examples_command_and_a_shipped_name_on_the_command_line(tmp_path):
     p = _cli("examples")
-    assert p.returncode == 0 and "scenarios:" in p.stdout and "experiments:" in p.stdout
+    assert p.returncode == 0 and "scenario files:" in p.stdout and "experiment files:" in p.stdout
     assert "  head_on  " in p.stdout.replace("head_on   ", "head_on  ")
     bad = _cli("simulate", "no_such_scenario", cwd=tmp_path)
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1

@@ -49,7 +49,7 @@ def cmd_examples(args: argparse.Namespace) -> int:
     for e in found:
         if e.kind != kind:
             kind = e.kind
-            print(f"{'' if e is found[0] else chr(10)}{kind}s:")
+            print(f"{'' if e is found[0] else chr(10)}{kind} files:")
         print(f"  {e.name:<{width}}  {e.summary}")
     return 0
 

@@ -37,7 +37,7 @@ Usage::
         [--queries 60] [--seed 0] [--nx-queries 3] [--data DIR] [--json out.json]
 
 ``--json`` writes ``{"machine", "load_end", "queries", "seed", "rows"}`` (a row per map,
-tool and corner rule), what ``benchmarks/run_all.py`` renders into the README.
+tool and corner rule), what ``benchmarks/run_all.py`` renders into docs/speed.md.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
-"""Re-measure the speed figures the README quotes and write them into it.
+"""Re-measure the speed figures the documentation quotes and write them into it.
 
-Each figure of the README's generated speed blocks comes from one benchmark's
+Each figure of the generated speed blocks of ``docs/speed.md`` comes from one benchmark's
 JSON output in ``benchmarks/results/``; this script runs the benchmarks, keeps
 their JSON there, and rewrites each block between its markers::
 
@@ -26,7 +26,7 @@ Usage::
 
     python benchmarks/run_all.py [--only search peers plan startup stepping] [--no-run] [--check]
 
-``--no-run`` only rewrites the README from the JSON already there; ``--check``
+``--no-run`` only rewrites the speed page from the JSON already there; ``--check``
 rewrites nothing and exits 1 when a block differs from its JSON.  The run takes
 about 10 minutes on 2 cores (``--only`` to run fewer); the machine's load is
 part of every block, as the machines are shared.
@@ -45,7 +45,7 @@ from typing import Any
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 RESULTS = HERE / "results"
-README = ROOT / "README.md"
+SPEED_PAGE = ROOT / "docs" / "speed.md"  # the speed page (the README links to it)
 BLOCKS = ("search", "peers", "plan", "startup", "stepping")
 
 
@@ -246,7 +246,7 @@ def _pattern(name: str) -> re.Pattern[str]:
 
 
 def blocks_in(text: str) -> dict[str, str]:
-    """The generated blocks of a README text, by name."""
+    """The generated blocks of a page's text, by name."""
     out = {}
     for name in BLOCKS:
         m = _pattern(name).search(text)
@@ -259,7 +259,7 @@ def rewrite(text: str, names: list[str]) -> str:
     for name in names:
         pat = _pattern(name)
         if not pat.search(text):
-            raise SystemExit(f"README.md has no block speed:{name}")
+            raise SystemExit(f"{SPEED_PAGE.name} has no block speed:{name}")
         body = render(name)
         text = pat.sub(lambda m, body=body: m.group(1) + body + m.group(3), text)
     return text
@@ -296,11 +296,11 @@ def run(name: str) -> None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", nargs="+", choices=BLOCKS, default=list(BLOCKS))
-    ap.add_argument("--no-run", action="store_true", help="only rewrite the README")
+    ap.add_argument("--no-run", action="store_true", help="only rewrite docs/speed.md")
     ap.add_argument("--check", action="store_true",
-                    help="exit 1 when a README block differs from its JSON")
+                    help="exit 1 when a block of docs/speed.md differs from its JSON")
     args = ap.parse_args(argv)
-    text = README.read_text()
+    text = SPEED_PAGE.read_text()
     if args.check:
         bad = [n for n, body in blocks_in(text).items() if body != render(n)]
         print("stale blocks: " + ", ".join(bad) if bad else "every block is up to date")
@@ -308,8 +308,8 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_run:
         for name in args.only:
             run(name)
-    README.write_text(rewrite(README.read_text(), args.only))
-    print(f"\nrewrote the blocks {', '.join(args.only)} of {README}")
+    SPEED_PAGE.write_text(rewrite(SPEED_PAGE.read_text(), args.only))
+    print(f"\nrewrote the blocks {', '.join(args.only)} of {SPEED_PAGE}")
     return 0
 
 

@@ -3,7 +3,7 @@
 Every ``import`` and ``from ... import`` statement of every module is read
 (inside functions too: a deferred import is still a dependency); imports
 under ``if TYPE_CHECKING:`` are left out (they never run).  The layers, low
-to high, are those of the README's architecture section.
+to high, are those of the architecture page (docs/architecture.md).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "pathfuse"
 
 # low -> high; a module may import its own layer and the layers below it
 LAYERS: list[tuple[str, ...]] = [
-    ("_version", "result", "validate", "limits", "safeyaml"),
+    ("_version", "result", "validate", "limits", "safeyaml", "shipped", "datasets"),
     ("grid", "geometry", "problem", "stats", "robot", "sweep", "shield"),
     ("search", "field", "io", "generate", "metrics", "metrics_kernels"),
     ("planners", "api"),
@@ -29,7 +29,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("cli", "web", "__init__", "__main__"),
 ]
 MAX_LINES = 600
-# modules allowed above MAX_LINES, each with the README's reason
+# modules allowed above MAX_LINES, each with the reason in docs/architecture.md
 LONG: set[str] = set()
 
 
@@ -146,5 +146,5 @@ def test_no_module_is_too_long():
     long = {str(p.relative_to(SRC)): sum(1 for _ in p.open(encoding="utf-8"))
             for p in MODULES.values()}
     over = {k: n for k, n in long.items() if n > MAX_LINES and k not in LONG}
-    assert not over, f"modules over {MAX_LINES} lines (split them, or explain in the README " \
-                     f"and list them in LONG): {over}"
+    assert not over, f"modules over {MAX_LINES} lines (split them, or explain in " \
+                     f"docs/architecture.md and list them in LONG): {over}"

@@ -155,7 +155,7 @@ planners:
     assert "1 of them raised (ERROR), --retry-errors runs them again" in p.stdout
     p = run("bench", "e.yaml", "--db", db, "--workers", "1", "--no-progress",
             "--retry-errors", cwd=tmp_path)
-    assert p.returncode == 1 and "1 runs in" in p.stdout and "3 already stored" in p.stdout
+    assert p.returncode == 1 and ": 1 run in" in p.stdout and "3 already stored" in p.stdout
     assert count(db) == 4
     rep = run("report", db, "--out", tmp_path / "rep")
     assert rep.returncode == 0, rep.stderr

@@ -1,4 +1,4 @@
-"""The shipped scenario examples end as their comments (and the README) say."""
+"""The shipped scenario examples end as their comments (and the docs) say."""
 
 from __future__ import annotations
 
@@ -45,21 +45,22 @@ def test_head_on_astar_collides_and_fusion_passes():
 
 
 def _as_commented(value: object, shown: str) -> str:
-    """``value`` as the README comment ``shown`` writes it (floats to its decimals)."""
+    """``value`` as the comment ``shown`` writes it (floats to its decimals)."""
     if isinstance(value, float) and not isinstance(value, bool):
         decimals = len(shown.split(".", 1)[1]) if "." in shown else 0
         return f"{value:.{decimals}f}"
     return str(value)
 
 
-def test_the_readme_moving_obstacles_example_prints_what_its_comments_say(monkeypatch):
-    """Each ``ep.<attr>, ...   # value, ...`` line of the README's first moving-obstacle
-    example is run; the values before a comment's first ':' are what it prints."""
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = text[text.index("## Moving obstacles"):]
+def test_the_docs_moving_obstacles_example_prints_what_its_comments_say(monkeypatch):
+    """Each ``ep.<attr>, ...   # value, ...`` line of the first example of the moving
+    obstacles' guide (docs/guide/moving-obstacles.md) is run; the values before a comment's
+    first ':' are what it prints."""
+    section = (ROOT / "docs" / "guide" / "moving-obstacles.md").read_text(encoding="utf-8")
+    assert section.startswith("# Moving obstacles")
     code = section[section.index("```python") + len("```python"):]
     code = code[:code.index("```")]
-    monkeypatch.chdir(ROOT)  # the README's paths are those of a clone
+    monkeypatch.chdir(ROOT)  # the page's paths are those of a clone
     env: dict[str, object] = {}
     checked = 0
     for line in code.splitlines():
@@ -67,7 +68,7 @@ def test_the_readme_moving_obstacles_example_prints_what_its_comments_say(monkey
         if not stmt.strip():
             continue
         if not stmt.startswith("ep.") or not comment.strip():
-            exec(stmt, env)  # noqa: S102 - the README's own example
+            exec(stmt, env)  # noqa: S102 - the page's own example
             continue
         got = eval(stmt, env)  # noqa: S307
         got = got if isinstance(got, tuple) else (got,)

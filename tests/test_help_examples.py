@@ -2,9 +2,10 @@
 
 Every file an example reads must exist in the repository (a new user copies the
 examples from a clone), and the quick examples (``plan``, ``scen``, ``simulate``,
-``planners``) are run, from the repository's root, with their output files redirected
-into a temporary folder.  The long studies (``paper``, ``dynamic``, ``bench``,
-``report``, ``barn``, ``serve``) are only checked for their input files.
+``planners``, ``examples``) are run, from the repository's root, with their output files
+redirected into a temporary folder.  The long studies (``paper``, ``dynamic``, ``bench``,
+``report``, ``barn``, ``serve``) and ``data`` (it needs the network) are only checked for
+their input files.
 """
 
 from __future__ import annotations
@@ -19,9 +20,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 COMMANDS = ("plan", "scen", "paper", "simulate", "dynamic", "bench", "report", "planners",
-            "barn", "serve")
-OUTPUT_OPTIONS = ("--plot", "--gif", "--mp4", "--db", "--out")
-RUN = ("plan", "scen", "simulate", "planners")
+            "barn", "serve", "examples", "data")
+OUTPUT_OPTIONS = ("--plot", "--gif", "--mp4", "--db", "--out", "--copy", "--to")
+RUN = ("plan", "scen", "simulate", "planners", "examples")
 
 
 def _help(*args: str) -> str:
@@ -72,7 +73,7 @@ def _inputs(argv: list[str]) -> list[str]:
         if skip_next:
             skip_next = False
             continue
-        if tok in OUTPUT_OPTIONS or tok == "--scheduler":
+        if tok in OUTPUT_OPTIONS or tok in ("--scheduler", "--only", "--mirror"):
             skip_next = True
             continue
         if tok.startswith("-"):

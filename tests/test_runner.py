@@ -584,3 +584,18 @@ def test_workers_that_cannot_start_stop_the_sweep_at_once(tmp_path):
         assert st.conn.execute("SELECT state FROM pathfuse_sessions").fetchone()[0] == "failed"
     # in-process the same sweep runs
     assert run_bench(exp, tmp_path / "w.db", workers=1, progress=False).errors == 0
+
+
+def test_the_sweep_summary_counts_runs_in_words():
+    """One run is "1 run", not "1 runs" (issue 19's leftover), in every line that counts."""
+    from pathfuse.bench.runner import SweepSummary
+
+    one = SweepSummary("tiny", "t.db", total=4, skipped=3, ran=1, succeeded=1, wall_s=0.5)
+    text = str(one)
+    assert "tiny: 1 run in 0.5 s" in text and "of the 1 run now: solved 1" in text
+    assert "1 runs" not in text
+    many = str(SweepSummary("tiny", "t.db", total=4, ran=4, succeeded=4, wall_s=1.0))
+    assert "tiny: 4 runs in 1.0 s" in many and "of the 4 runs now" in many
+    done = str(SweepSummary("tiny", "t.db", total=1, skipped=1))
+    assert "nothing to run, its one run is already stored in t.db" in done
+    assert "summarises it)" in done

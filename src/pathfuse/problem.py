@@ -85,7 +85,7 @@ class Problem:
     clearance_m : float
         The soft safety margin beyond the radius (ours; 0 = off): the global
         planner pays for coming closer to an obstacle, the controllers keep
-        it where they can (see the README).
+        it where they can (see the robots guide, docs/guide/robots.md).
     robot : RobotModel or None
         The robot's kinematic model (:class:`pathfuse.robot.RobotModel`);
         None: a holonomic robot (offline, the geometric planners ignore it;

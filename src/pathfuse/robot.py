@@ -23,7 +23,7 @@ Models (``kind``)
 The footprint is a disc of ``radius_m`` for both models (so turning on the
 spot never collides).  ``clearance_m`` is a *soft* safety margin (ours): the
 global planner pays a cost to come closer than it to an obstacle and the
-controllers keep it where they can (see the README's "Robots, kinematics and
+controllers keep it where they can (see the guide's "Robots, kinematics and
 the safety margin").  ``inflation_m`` is the global planner's inflation alone
 (ours, after Nav2's inflation layer): the A* path pays a cost to pass closer
 than it to an obstacle, so it runs down the middle of passages where the map

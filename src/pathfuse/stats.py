@@ -55,6 +55,8 @@ def bootstrap_mean_ci(values: Sequence[float], level: float = 0.95, n_boot: int 
     goes below zero, unlike the Student-t interval of a skewed sample.  NaN for an empty
     sample; a zero-width interval for one value.
 
+    Examples
+    --------
     >>> times = [0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 20.0]   # skewed, like timings
     >>> round(mean_ci(times)[1], 2) < 0 < bootstrap_mean_ci(times)[1]
     True
@@ -82,6 +84,8 @@ def wilson_ci(successes: int, n: int, level: float = 0.95) -> tuple[float, float
 
     NaN for ``n == 0``.
 
+    Examples
+    --------
     >>> [round(v, 4) for v in wilson_ci(95, 100)]
     [0.95, 0.8882, 0.9785]
     >>> wilson_ci(0, 50)[:2], wilson_ci(50, 50)[::2]

@@ -441,7 +441,8 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
             raise ConfigError(f"{where}.scen: expected a .scen file path, got {_short(scen)}")
         sp = Path(scen) if Path(scen).is_absolute() else exp_dir / scen
         if not sp.is_file():
-            raise ConfigError(f"{where}.scen: no such file {sp}")
+            from pathfuse.datasets import missing_hint
+            raise ConfigError(f"{where}.scen: no such file {sp} ({missing_hint('movingai')})")
         if family != "movingai":
             raise ConfigError(f"{where}.scen: scen files go with MovingAI maps "
                               f"({{movingai: FILE}}), not {_shown(family)}")
@@ -570,7 +571,9 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
         p = Path(os.path.expanduser(rel))
         p = p if p.is_absolute() else exp_dir / p
         if not p.is_file():
-            raise ConfigError(f"{where}.{family}: no such file {p}")
+            from pathfuse.datasets import missing_hint
+            hint = f" ({missing_hint('movingai')})" if family == "movingai" else ""
+            raise ConfigError(f"{where}.{family}: no such file {p}{hint}")
     return spec, family
 
 

@@ -102,15 +102,16 @@ class SweepSummary:
         if self.ran == 0 and self.complete and not self.interrupted:
             errs = (f"; {self.stored_errors} of them raised (ERROR), --retry-errors runs "
                     "them again") if self.stored_errors else ""
-            return (f"{self.experiment}: nothing to run, all {self.total} runs are already "
+            every = (f"all {self.total} runs are" if self.total != 1 else "its one run is")
+            return (f"{self.experiment}: nothing to run, {every} already "
                     f"stored in {self.db_path} ('pathfuse report {self.db_path}' summarises "
-                    f"them){errs}")
+                    f"{'them' if self.total != 1 else 'it'}){errs}")
         comp = f", {self.compile_s:.1f} s of it compiling kernels" \
             if self.compile_s >= 1.0 else ""
-        head = (f"{self.experiment}: {self.ran} runs in {self.wall_s:.1f} s "
+        head = (f"{self.experiment}: {_count(self.ran, 'run')} in {self.wall_s:.1f} s "
                 f"({self.runs_per_s:.1f} runs/s, {where}{comp}); {self.skipped} already stored; "
                 f"{stored}/{self.total} in {self.db_path}")
-        tail = (f"\n  of the {self.ran} run now: solved {self.succeeded}, not solved "
+        tail = (f"\n  of the {_count(self.ran, 'run')} now: solved {self.succeeded}, not solved "
                 f"{self.failed}, errors {self.errors}")
         if self.crashed:
             tail += f" ({self.crashed} crashed their worker)"
@@ -119,6 +120,15 @@ class SweepSummary:
         for e in self.error_samples:
             tail += f"\n  error: {e}"
         return head + tail
+
+
+def _count(n: int, noun: str) -> str:
+    """``n`` and ``noun``, plural unless ``n`` is 1.
+
+    >>> _count(1, "run"), _count(0, "run"), _count(3, "run")
+    ('1 run', '0 runs', '3 runs')
+    """
+    return f"{n} {noun}{'' if n == 1 else 's'}"
 
 
 class SweepInterrupted(KeyboardInterrupt):

@@ -38,9 +38,12 @@ examples:
   pathfuse bench experiments/fusion-sweep-r1-r2-step.yaml --db sweep.db --seeds 20
   pathfuse report sweep.db --out sweep-report
   pathfuse planners
+  pathfuse examples
+  pathfuse data download barn --to barn-data
 
-The paths are those of a clone of the repository.  Run 'pathfuse COMMAND --help' for the
-options of a command.
+The paths are those of a clone of the repository; 'pathfuse examples' lists the scenario
+and experiment files every installation has, which commands also take by name.  Run
+'pathfuse COMMAND --help' for the options of a command.
 """)
 
 

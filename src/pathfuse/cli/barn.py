@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 from typing import Any
 
 from pathfuse.cli.args import _fmt, _nonneg_int, _Parser, _positive_float, _positive_int
@@ -86,6 +87,7 @@ examples:
 def cmd_barn(args: argparse.Namespace) -> int:
     from pathfuse.cli.args import parse_planner_list, parse_planner_params
     from pathfuse.cli.commands import _study_db, _warm_with_notice
+    from pathfuse.shipped import examples, resolve
     from pathfuse.studies.barn import BarnConfig, jackal_robot, load_barn_file, run_barn
     from pathfuse.studies.barn_report import (
         json_lines,
@@ -94,6 +96,10 @@ def cmd_barn(args: argparse.Namespace) -> int:
         write_barn_outputs,
     )
 
+    if not Path(args.target).expanduser().exists():  # a shipped experiment file by name?
+        stem = args.target[:-5] if args.target.endswith(".yaml") else args.target
+        if stem in {e.name for e in examples("experiment")}:
+            args.target = resolve(args.target, "experiment")
     if args.target.lower().endswith((".yaml", ".yml")):
         base, _ = load_barn_file(args.target)
     else:

@@ -270,6 +270,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         parent = Path(out).expanduser().resolve().parent
         if not parent.is_dir():
             raise CliError(f"--{fmt}: the folder {parent} does not exist")
+    from pathfuse.shipped import resolve
+
+    args.scenario = resolve(args.scenario, "scenario")
     sc = load_scenario(args.scenario)
     params = parse_params(args.param)
     if args.planner is None or args.planner == sc.planner.name:
@@ -430,8 +433,10 @@ def _quiet_dask_logs() -> None:
 
 def cmd_bench(args: argparse.Namespace) -> int:
     from pathfuse.bench import ClusterLost, SweepInterrupted, run_bench
+    from pathfuse.shipped import resolve
 
     seeds = None if args.seeds is None else parse_seeds(args.seeds)
+    args.experiment = resolve(args.experiment, "experiment")
     _announce_imports(args.experiment)
     if args.scheduler:  # a lost cluster is one line of ours, not Dask's tracebacks
         _quiet_dask_logs()

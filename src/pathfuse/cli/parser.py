@@ -30,6 +30,7 @@ from pathfuse.cli.commands import (
     cmd_simulate,
 )
 from pathfuse.cli.irsim import add_irsim_parser
+from pathfuse.cli.shipped import add_data_parser, add_examples_parser
 from pathfuse.result import PathfuseError
 
 
@@ -158,6 +159,7 @@ examples:
         epilog=_fmt("""
 examples:
   pathfuse simulate examples/scenarios/head_on.yaml
+  pathfuse simulate head_on --planner fusion
   pathfuse simulate examples/scenarios/head_on.yaml --planner astar --gif head_on.gif
   pathfuse simulate examples/scenarios/corridor_crowd.yaml --planner dwa --robot model=diff-drive
   pathfuse simulate examples/scenarios/crossing.yaml --planner fusion --param repulsion=velocity
@@ -171,7 +173,8 @@ an animation plays in real time unless that takes more than 150 frames, then fas
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    sm.add_argument("scenario", help="scenario YAML file")
+    sm.add_argument("scenario", help="scenario YAML file, or the name of a shipped one "
+                    "('pathfuse examples' lists them)")
     sm.add_argument("--planner", help="planner (default: the scenario's)")
     sm.add_argument("--param", action="append", metavar="KEY=VALUE",
                     help="planner parameter, repeatable (e.g. --param repulsion=velocity)")
@@ -242,6 +245,8 @@ examples:
 
     add_barn_parser(sub)
     add_irsim_parser(sub)
+    add_examples_parser(sub)
+    add_data_parser(sub)
 
     b = sub.add_parser(
         "bench",
@@ -267,7 +272,8 @@ See experiments/*.yaml for the file format (maps, seeds, planners, swept paramet
 """),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    b.add_argument("experiment", help="experiment YAML file")
+    b.add_argument("experiment", help="experiment YAML file, or the name of a shipped one "
+                   "('pathfuse examples' lists them)")
     b.add_argument("--db", required=True, metavar="STUDY.db",
                    help="SQLite study database (created if missing, resumed if not)")
     b.add_argument("--seeds", metavar="N|A:B|A,B,..",
@@ -362,7 +368,8 @@ def _add_serve(sub: argparse._SubParsersAction) -> None:
         description="Start a local web app: draw or load a map, drag start and goal, run "
         "any registered planners side by side, look at the potential field, the A* closed "
         "set and the c-space, and play moving-obstacle episodes.  Its JSON API is "
-        "documented in the README.  Binds to 127.0.0.1 unless --host says otherwise, and "
+        "documented in docs/guide/playground.md.  Binds to 127.0.0.1 unless --host says "
+        "otherwise, and "
         "answers requests that name a loopback host (localhost, 127.0.0.1, ::1) unless "
         "--allow-host adds names.  Every computation runs in a worker process that is "
         "stopped at the --budget.",

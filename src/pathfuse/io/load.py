@@ -138,7 +138,12 @@ def load_map(
             f"supported: 'paper', {', '.join(SUPPORTED_SUFFIXES)}"
         )
     if not path.exists():
-        raise MapFormatError(f"map file not found: {path}")
+        hint = ""
+        if suffix == ".map":
+            from pathfuse.datasets import missing_hint
+
+            hint = f" (the MovingAI benchmarks: {missing_hint('movingai')})"
+        raise MapFormatError(f"map file not found: {path}{hint}")
     if path.is_dir():
         raise MapFormatError(f"map path is a directory, not a file: {path}")
     if suffix == ".map":

@@ -93,7 +93,9 @@ def _read_lines(path: Path) -> list[bytes]:
     try:
         data = read_capped(path, "the map file")
     except FileNotFoundError:
-        raise MapFormatError(f"{path}: no such map file") from None
+        from pathfuse.datasets import missing_hint
+        raise MapFormatError(f"{path}: no such map file (the MovingAI benchmarks: "
+                             f"{missing_hint('movingai')})") from None
     except IsADirectoryError:
         raise MapFormatError(f"{path}: is a directory, not a map file") from None
     except OSError as exc:

@@ -80,7 +80,9 @@ def _lines(path: Path) -> list[str]:
     try:
         data = read_capped(path, "the scenario file")
     except FileNotFoundError:
-        raise MapFormatError(f"{path}: no such scenario file") from None
+        from pathfuse.datasets import missing_hint
+        raise MapFormatError(f"{path}: no such scenario file (the MovingAI benchmarks: "
+                             f"{missing_hint('movingai')})") from None
     except IsADirectoryError:
         raise MapFormatError(f"{path}: is a directory, not a scenario file") from None
     except OSError as exc:

@@ -6,7 +6,7 @@ A* points' attraction (within ``r1``) and the obstacles' repulsion (within
 holonomic robot takes that move as its velocity (the paper's model, and
 pathfuse's Tables I/II).  A diff-drive robot cannot: it must turn and brake,
 and following the move's direction tick by tick made it swing and graze
-(the README's BARN and dynamic studies before this module).
+(the BARN and dynamic results in docs/results before this module).
 
 :class:`ForceWindow` keeps Algorithm 2 as the judge of *where* to go and lets
 the dynamic window decide *how*.  Each tick:

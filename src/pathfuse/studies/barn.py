@@ -207,8 +207,9 @@ def find_worlds(directory: str | os.PathLike[str],
     """
     d = Path(os.path.expanduser(os.fspath(directory)))
     if not d.is_dir():
+        from pathfuse.datasets import missing_hint
         raise ConfigError(f"{d}: no such folder (expected a BARN folder with worlds/ and "
-                          "path_files/)")
+                          f"path_files/; {missing_hint('barn')})")
     wdir = d / "worlds" if (d / "worlds").is_dir() else d
     pdir = wdir.parent / "path_files" if wdir.name == "worlds" or not (d / "path_files").is_dir() \
         else d / "path_files"

@@ -75,10 +75,21 @@ _TYPES = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=
 
 def default_map_folders() -> list[tuple[str, Path]]:
     """``examples/`` and ``tests/data/`` of the source tree pathfuse runs from (a clone
-    installed with ``pip install -e``), when they exist, as (label, folder)."""
+    installed with ``pip install -e``), when they exist, as (label, folder); otherwise the
+    examples shipped in the package (:mod:`pathfuse.shipped`)."""
     root = Path(__file__).resolve().parents[3]
     pairs = [("examples", root / "examples"), ("tests/data", root / "tests" / "data")]
-    return [(label, p) for label, p in pairs if p.is_dir()]
+    found = [(label, p) for label, p in pairs if p.is_dir()]
+    if not found:
+        from pathfuse.shipped import shipped_root
+
+        try:
+            packaged = shipped_root()
+        except PathfuseError:
+            return []
+        found = [(label, packaged / label) for label in ("examples", "tests/data")
+                 if (packaged / label).is_dir()]
+    return found
 
 
 def _static_files() -> dict[str, tuple[bytes, str]]:

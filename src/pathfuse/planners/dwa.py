@@ -105,7 +105,7 @@ __all__ = ["DWAParams", "DWAController"]
 
 
 @dataclass(frozen=True)
-class DWAParams(GlobalAStarParams, SocialParams):
+class DWAParams(SocialParams, GlobalAStarParams):
     """Parameters of ``dwa`` (the sampling, the horizon and the critics' weights)."""
 
     v_samples: int = param(7, ge=2, help="linear speeds sampled in the window (holonomic: "

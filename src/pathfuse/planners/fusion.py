@@ -104,7 +104,7 @@ FUSION_STEP_FRAC = 0.5
 
 
 @dataclass(frozen=True)
-class FusionParams(GlobalAStarParams, DiscParams, FieldParams, SocialParams):
+class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams):
     """Parameters of the fusion planner (paper values for K_att, K_rep, rho_0).
 
     The default ``step_m`` offline is :data:`FUSION_STEP_FRAC` (0.5) x the map

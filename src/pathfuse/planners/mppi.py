@@ -105,7 +105,7 @@ __all__ = ["MPPIParams", "MPPIController", "clearance_field"]
 
 
 @dataclass(frozen=True)
-class MPPIParams(GlobalAStarParams, PersonalSpaceParams):
+class MPPIParams(PersonalSpaceParams, GlobalAStarParams):
     """Parameters of ``mppi`` (the sampling, the update and the critics' weights)."""
 
     batch_size: int = param(600, ge=4, help="control sequences sampled per tick (Nav2: 1000)")

@@ -39,7 +39,7 @@ from pathfuse.stats import markdown_table, mean_ci, wilson_ci, write_csv
 
 __all__ = ["summary_rows", "markdown_report", "text_table", "write_barn_outputs",
            "OUTCOMES", "PERCENTILES", "fault_stats", "percentile_stats", "shield_stats",
-           "fault_cell", "percentile_cell", "shield_cell"]
+           "fault_cell", "percentile_cell", "shield_cell", "social_stats", "SOCIAL_GAP_M"]
 
 OUTCOMES = ("success", "collision", "timeout")
 PERCENTILES = (5, 50)
@@ -87,6 +87,24 @@ def percentile_stats(values: Sequence[float | None], prefix: str,
     for q in PERCENTILES:
         out[f"{prefix}_p{q}{unit}"] = float(np.percentile(v, q)) if v else math.nan
     return out
+
+
+SOCIAL_GAP_M = 0.3
+"""A *social success* (issue 18's measure) reaches the goal and never comes closer than
+this to any moving disc (the least gap between the robot's and the disc's edges)."""
+
+
+def social_stats(ok: Sequence[Mapping[str, Any]], n: int) -> dict[str, Any]:
+    """The social successes among the successful records ``ok`` of ``n`` episodes: count,
+    rate and 95 % Wilson interval (an episode without discs has an infinite gap).
+
+    >>> social_stats([{"min_obstacle_distance_m": 0.5}, {"min_obstacle_distance_m": 0.1}],
+    ...              4)["social"]
+    1
+    """
+    c = sum(1 for r in ok if float(r["min_obstacle_distance_m"]) >= SOCIAL_GAP_M)
+    p, lo, hi = wilson_ci(c, n)
+    return {"social": c, "social_rate": p, "social_ci_low": lo, "social_ci_high": hi}
 
 
 def shield_stats(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:

@@ -49,12 +49,14 @@ from pathfuse.bench.summary import group_stats, value_stats
 from pathfuse.result import ConfigError
 from pathfuse.stats import markdown_table, write_csv
 from pathfuse.studies.barn_report import (
+    SOCIAL_GAP_M,
     fault_cell,
     fault_stats,
     percentile_cell,
     percentile_stats,
     shield_cell,
     shield_stats,
+    social_stats,
 )
 from pathfuse.validate import short as _shown
 
@@ -69,10 +71,6 @@ __all__ = [
     "markdown_report",
     "write_dynamic_outputs",
 ]
-
-SOCIAL_GAP_M = 0.3
-"""A *social success* (issue 18's measure) reaches the goal and never comes closer than
-this to any moving disc (the least gap between the robot's and the disc's edges)."""
 
 #: Episode statuses in table order (``EpisodeStatus`` names).
 OUTCOMES = ("SUCCESS", "COLLISION", "TIMEOUT", "LOCAL_MINIMUM", "NO_PATH")
@@ -376,7 +374,7 @@ def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
                 row.update({f"{key}_rate": g[f"{low}_rate"], f"{key}_ci_low": g[f"{low}_ci_low"],
                             f"{key}_ci_high": g[f"{low}_ci_high"]})
             ok = [r for r in recs if r["status"] == "SUCCESS"]
-            row.update(_social(ok, len(recs)))
+            row.update(social_stats(ok, len(recs)))
             for col, label, unit, ci in (("path_length_m", "path_length", "_m", "t"),
                                          ("time_to_goal_s", "time_to_goal", "_s", "bootstrap")):
                 v = value_stats([float(r[col]) for r in ok], label, unit, ci=ci)
@@ -391,16 +389,6 @@ def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
             row.update(shield_stats(recs))
             rows.append(row)
     return rows
-
-
-def _social(ok: Sequence[Mapping[str, Any]], n: int) -> dict[str, Any]:
-    """The social successes among the successful records ``ok`` of ``n`` episodes: count,
-    rate and 95 % Wilson interval (an episode without discs has an infinite gap)."""
-    from pathfuse.stats import wilson_ci
-
-    c = sum(1 for r in ok if float(r["min_obstacle_distance_m"]) >= SOCIAL_GAP_M)
-    p, lo, hi = wilson_ci(c, n) if n else (math.nan, math.nan, math.nan)
-    return {"social": c, "social_rate": p, "social_ci_low": lo, "social_ci_high": hi}
 
 
 def paired_rows(run: DynamicRun, reference: str = "fusion") -> list[dict[str, Any]]:

@@ -33,9 +33,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
+from pathfuse import validate
+from pathfuse.result import ConfigError
 from pathfuse.world.obstacles import (
     LinearObstacle,
     ObstacleSpec,
@@ -43,7 +46,7 @@ from pathfuse.world.obstacles import (
     RandomWalkObstacle,
 )
 
-__all__ = ["Perturbation", "perturb_obstacles", "ATTEMPTS", "PERTURB_KEYS"]
+__all__ = ["Perturbation", "perturb_obstacles", "parse_perturb", "ATTEMPTS", "PERTURB_KEYS"]
 
 ATTEMPTS = 32
 """Draws per disc before it keeps its written motion."""
@@ -77,6 +80,22 @@ class Perturbation:
     def to_dict(self) -> dict[str, float]:
         return {"position_m": self.position_m, "speed_frac": self.speed_frac,
                 "heading_deg": self.heading_deg}
+
+
+def parse_perturb(v: Any, error: type[ConfigError]) -> Perturbation | None:
+    """The ``perturb:`` section of a scenario file (None when absent); a bad key or value
+    raises ``error`` naming it."""
+    if v is None:
+        return None
+    m = validate.mapping(v, "perturb", PERTURB_KEYS, "a mapping", error)
+    return Perturbation(
+        position_m=validate.number(m.get("position_m", 0.0), "perturb.position_m", ge=0,
+                                   error=error),
+        speed_frac=validate.number(m.get("speed_frac", 0.0), "perturb.speed_frac", ge=0,
+                                   lt=1, error=error),
+        heading_deg=validate.number(m.get("heading_deg", 0.0), "perturb.heading_deg", ge=0,
+                                    le=180, error=error),
+    )
 
 
 def _offset(rng: np.random.Generator, r: float) -> tuple[float, float]:

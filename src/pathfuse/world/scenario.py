@@ -79,7 +79,7 @@ from pathfuse.world.obstacles import (
     PatrolObstacle,
     RandomWalkObstacle,
 )
-from pathfuse.world.perturb import PERTURB_KEYS, Perturbation, perturb_obstacles
+from pathfuse.world.perturb import Perturbation, parse_perturb, perturb_obstacles
 from pathfuse.world.robot import RobotSpec, parse_robot
 
 __all__ = [
@@ -189,16 +189,8 @@ class Scenario:
 
     def obstacles_for(self, seed: int | None) -> tuple[ObstacleSpec, ...]:
         """The discs of the episode with ``seed``: as written without a seed or a
-        ``perturb`` section, else jittered (:func:`~pathfuse.world.perturb.perturb_obstacles`).
-
-        >>> sc = load_scenario({"map": {"rows": ["......"] * 3}, "start": [0.5, 1.5],
-        ...                     "goal": [5.5, 1.5], "perturb": {"position_m": 0.3},
-        ...                     "obstacles": [{"position": [3, 1.5], "velocity": [-0.5, 0]}]})
-        >>> sc.obstacles_for(None) == sc.obstacles, sc.obstacles_for(1) == sc.obstacles_for(1)
-        (True, True)
-        >>> sc.obstacles_for(1) != sc.obstacles_for(2)
-        True
-        """
+        ``perturb`` section, else jittered (:func:`~pathfuse.world.perturb.perturb_obstacles`;
+        examples in ``tests/test_perturb.py``)."""
         if seed is None or self.perturb is None or not self.perturb.active:
             return self.obstacles
 
@@ -334,9 +326,7 @@ def _check_scene(sc: Scenario) -> None:
         p = sc.perturb
         if not isinstance(p, Perturbation):
             raise ScenarioError(f"perturb: must be a Perturbation, got {type(p).__name__}")
-        _num(p.position_m, "perturb.position_m", ge=0)
-        _num(p.speed_frac, "perturb.speed_frac", ge=0, lt=1)
-        _num(p.heading_deg, "perturb.heading_deg", ge=0, le=180)
+        parse_perturb(p.to_dict(), ScenarioError)
 
 
 def _check_disc(sc: Scenario, i: int, ob: ObstacleSpec) -> None:
@@ -401,17 +391,6 @@ def _mapping(v: Any, key: str, allowed: tuple[str, ...], what: str = "a mapping"
 
 
 # ---------------------------------------------------------------------- section parsers
-def _parse_perturb(v: Any) -> Perturbation | None:
-    if v is None:
-        return None
-    m = _mapping(v, "perturb", PERTURB_KEYS)
-    return Perturbation(
-        position_m=_num(m.get("position_m", 0.0), "perturb.position_m", ge=0),
-        speed_frac=_num(m.get("speed_frac", 0.0), "perturb.speed_frac", ge=0, lt=1),
-        heading_deg=_num(m.get("heading_deg", 0.0), "perturb.heading_deg", ge=0, le=180),
-    )
-
-
 def _parse_obstacle(v: Any, index: int) -> ObstacleSpec:
     key = f"obstacles[{index}]"
     if not isinstance(v, Mapping):
@@ -546,7 +525,7 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
         stall_time=_num(doc.get("stall_time", 10.0), "stall_time", ge=0),
         stall_radius=_num(doc.get("stall_radius", 0.25), "stall_radius", gt=0),
         seed=None if seed is None else _int(seed, "seed"),
-        perturb=_parse_perturb(doc.get("perturb")),
+        perturb=parse_perturb(doc.get("perturb"), ScenarioError),
         obstacles=tuple(_parse_obstacle(o, i) for i, o in enumerate(obstacles)),
         planner=_parse_planner(doc.get("planner")),
         name=_str(name, "name"),

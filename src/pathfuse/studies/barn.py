@@ -54,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-from pathfuse.result import ConfigError
+from pathfuse.result import ConfigError, Status
 
 __all__ = [
     "BARN_START", "BARN_START_YAW", "BARN_GOAL", "BARN_GOAL_TOLERANCE_M", "BARN_TIME_LIMIT_S",
@@ -485,9 +485,12 @@ def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: f
     moved = np.hypot(pos[:, 0] - BARN_START[0], pos[:, 1] - BARN_START[1]) >= BARN_MOVE_START_M
     t_start = float(times[int(np.argmax(moved))]) if moved.any() else 0.0
     end = float(times[-1])
-    success = status == "SUCCESS"
-    outcome = "success" if success else "collision" if status == "COLLISION" else "timeout"
-    time_s = end - t_start if success else (end - t_start if outcome == "collision"
+    success = status == Status.SUCCESS.name
+    # the challenge's three outcomes (barn_report.OUTCOMES): any other end is a timeout
+    ended = Status.SUCCESS if success else Status.COLLISION \
+        if status == Status.COLLISION.name else Status.TIMEOUT
+    outcome = ended.value
+    time_s = end - t_start if success else (end - t_start if ended is Status.COLLISION
                                             else BARN_TIME_LIMIT_S)
     rec: dict[str, Any] = {
         "world": int(world.index),

@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.bench.summary import group_stats, value_stats
-from pathfuse.result import ConfigError
+from pathfuse.result import ConfigError, Status
 from pathfuse.stats import markdown_table, write_csv
 from pathfuse.studies.barn_report import (
     fault_cell,
@@ -70,12 +70,11 @@ __all__ = [
     "write_dynamic_outputs",
 ]
 
-#: Episode statuses in table order (``EpisodeStatus`` names).
-OUTCOMES = ("SUCCESS", "COLLISION", "TIMEOUT", "LOCAL_MINIMUM", "NO_PATH")
-_OUTCOME_KEYS = {"SUCCESS": "reached", "COLLISION": "collision", "TIMEOUT": "timeout",
-                 "LOCAL_MINIMUM": "local_minimum", "NO_PATH": "no_path"}
-_OUTCOME_LABELS = {"SUCCESS": "success", "COLLISION": "collision", "TIMEOUT": "timeout",
-                   "LOCAL_MINIMUM": "local min", "NO_PATH": "no path"}
+_ORDER = (Status.SUCCESS, Status.COLLISION, Status.TIMEOUT, Status.LOCAL_MINIMUM,
+          Status.NO_PATH)
+#: Episode statuses in table order (:class:`~pathfuse.result.Status` names); a summary
+#: row counts each under its :attr:`~pathfuse.result.Status.key` ("reached", ...).
+OUTCOMES = tuple(s.name for s in _ORDER)
 
 
 def _is_int(v: Any) -> bool:
@@ -365,10 +364,10 @@ def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
                               "solution_length": None, "time": None, "time_to_goal": None}
                              for r in recs], statuses=OUTCOMES)
             row: dict[str, Any] = {"moving": k, "planner": name, "episodes": g["runs"]}
-            for st in OUTCOMES:
-                row[_OUTCOME_KEYS[st]] = g[st.lower()]
-            for st in OUTCOMES:
-                key, low = _OUTCOME_KEYS[st], st.lower()
+            for st in _ORDER:
+                row[st.key] = g[st.value]
+            for st in _ORDER:
+                key, low = st.key, st.value
                 row.update({f"{key}_rate": g[f"{low}_rate"], f"{key}_ci_low": g[f"{low}_ci_low"],
                             f"{key}_ci_high": g[f"{low}_ci_high"]})
             ok = [r for r in recs if r["status"] == "SUCCESS"]
@@ -474,17 +473,15 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
     rows = summary_rows(run) if rows is None else rows
     cfg = run.config
     lo, hi = cfg.speed_range
-    head = ["discs", "planner", "success [95% CI]", "collision", "timeout", "local min",
-            "no path", "path length (m) mean [95% CI]", "median", "time to goal (s) mean "
-            "[95% CI]", "median", "plan time/tick (µs)", "collisions: robot at fault / "
-            "hit standing", "min static clearance (m) p5 / p50", "min disc gap (m) p5 / p50",
-            "shield: commands replaced"]
+    head = ["discs", "planner", f"{_ORDER[0].label} [95% CI]",
+            *(s.label for s in _ORDER[1:]), "path length (m) mean [95% CI]", "median",
+            "time to goal (s) mean [95% CI]", "median", "plan time/tick (µs)",
+            "collisions: robot at fault / hit standing", "min static clearance (m) p5 / p50",
+            "min disc gap (m) p5 / p50", "shield: commands replaced"]
     table = [head]
     for r in rows:
         table.append([
-            str(r["moving"]), r["planner"], _rate_cell(r, "reached"),
-            _rate_cell(r, "collision"), _rate_cell(r, "timeout"),
-            _rate_cell(r, "local_minimum"), _rate_cell(r, "no_path"),
+            str(r["moving"]), r["planner"], *(_rate_cell(r, s.key) for s in _ORDER),
             _stat_cell(r, "path_length", "m"), _median_cell(r, "path_length", "m"),
             _stat_cell(r, "time_to_goal", "s"), _median_cell(r, "time_to_goal", "s"),
             "n/a" if not np.isfinite(r["mean_plan_time_us"]) else f"{r['mean_plan_time_us']:.0f}",

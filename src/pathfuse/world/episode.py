@@ -318,11 +318,10 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
                 path_updates.append((acted, np.array(gp)))
                 last_path = gp
             if terminated:
-                if info["event"] == "reached":
-                    status = Status.SUCCESS
+                status = Status.from_key(info["event"])
+                if status is Status.SUCCESS:
                     message = f"reached the goal at t = {obs.time:.2f} s"
                 else:
-                    status = Status.COLLISION
                     collision_with = info["collision"]
                     at_fault = info.get("at_fault")
                     what = "the static map" if collision_with == "static" \

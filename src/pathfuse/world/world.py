@@ -92,7 +92,7 @@ from typing import Any
 
 import numpy as np
 
-from pathfuse.result import PathfuseError, QueryError
+from pathfuse.result import PathfuseError, QueryError, Status
 from pathfuse.shield import clip_holonomic, clip_unicycle
 from pathfuse.sweep import arc_disc_gaps, arc_static_distance, unicycle_pose
 from pathfuse.validate import short as _shown
@@ -317,7 +317,8 @@ class World:
         truncated : bool
             The time limit was reached without termination.
         info : dict
-            ``event`` ("reached", "collision" or None), ``collision``
+            ``event`` ("reached", "collision" or None: the
+            :attr:`~pathfuse.result.Status.key` of the outcome), ``collision``
             ("static", the index of the disc hit, or None), ``static_gap``
             and ``obstacle_gap`` (least clearance over the tick, metres;
             ``inf`` without discs), ``clipped`` (speed limited), ``at_fault``
@@ -364,12 +365,12 @@ class World:
         collision: Any = None
         at_fault: bool | None = None
         if static_gap < 0.0:
-            event, collision, at_fault = "collision", "static", True
+            event, collision, at_fault = Status.COLLISION.key, "static", True
         elif hit_disc >= 0:
-            event, collision = "collision", hit_disc
+            event, collision = Status.COLLISION.key, hit_disc
             at_fault = self._moving(cmd)
         elif self._passes_goal(p0, p1, th0, cmd, arc):
-            event = "reached"
+            event = Status.SUCCESS.key
         self.position = p1
         self.velocity = (p1 - p0) / self.dt if self.diff_drive else cmd
         self.heading = float(th1)

@@ -33,13 +33,13 @@ Collisions (checked over the whole tick, not at its end points)
 ---------------------------------------------------------------
 * Static: the robot disc swept along its segment overlaps an occupied cell
   or leaves the map - exactly, with
-  :func:`~pathfuse.world.geometry.segment_static_distance` (closed-form
+  :func:`~pathfuse.sweep.segment_static_distance` (closed-form
   segment-to-square distances; no sampling, so no step size is too large).
   Along an arc: :func:`~pathfuse.sweep.arc_static_distance` (chords with a
   provable deviation bound, refined to 1e-9 m where it decides).
 * Moving discs: both centres move linearly over the tick, so their distance
   is minimised in closed form
-  (:func:`~pathfuse.world.geometry.disc_sweep_gaps`); along an arc,
+  (:func:`~pathfuse.sweep.disc_sweep_gaps`); along an arc,
   :func:`~pathfuse.sweep.arc_disc_gaps`.
 
 Who is at fault (``info["at_fault"]``)
@@ -92,15 +92,17 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse.geometry import point_segment_distance
 from pathfuse.result import PathfuseError, QueryError, Status
 from pathfuse.shield import clip_holonomic, clip_unicycle
-from pathfuse.sweep import arc_disc_gaps, arc_static_distance, unicycle_pose
-from pathfuse.validate import short as _shown
-from pathfuse.world.geometry import (
+from pathfuse.sweep import (
+    arc_disc_gaps,
+    arc_static_distance,
     disc_sweep_gaps,
-    point_segment_distance,
     segment_static_distance,
+    unicycle_pose,
 )
+from pathfuse.validate import short as _shown
 from pathfuse.world.obstacles import obstacle_trajectories
 from pathfuse.world.scenario import Scenario, load_scenario
 

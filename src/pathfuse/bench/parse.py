@@ -225,7 +225,7 @@ def _parse_reference(v: Any) -> dict[str, Any] | None:
     if isinstance(v, str):
         v = {"planner": v}
     if not isinstance(v, Mapping) or "planner" not in v or set(v) - {"planner", "params"}:
-        raise ConfigError(f"reference: expected a planner name or {{planner, params}}, "
+        raise ConfigError(f"reference: must be a planner name or {{planner, params}}, "
                           f"got {_short(v)}")
     try:
         spec = get_planner(v["planner"])
@@ -278,7 +278,7 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
     if isinstance(v, str):
         v = {"name": v}
     if not isinstance(v, Mapping):
-        raise ConfigError(f"{where}: expected a planner name or a mapping with name/params, "
+        raise ConfigError(f"{where}: must be a planner name or a mapping with name/params, "
                           f"got {_short(v)}")
     for k in v:
         if k not in _PLANNER_KEYS:
@@ -292,7 +292,7 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         want = [want] if isinstance(want, str) else want
         if not isinstance(want, list) or not want or \
                 not set(want) <= {"static", "dynamic"}:
-            raise ConfigError(f"{where}.kinds: expected a list of static / dynamic, "
+            raise ConfigError(f"{where}.kinds: must be a list of static / dynamic, "
                               f"got {_short(v['kinds'])}")
         kinds = [k for k in kinds if k in want]
     specs: dict[str, Any] = {}
@@ -318,7 +318,7 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         raise ConfigError(f"{where}.label: must be a non-empty string, got {_shown(label)}")
     raw = v.get("params") or {}
     if not isinstance(raw, Mapping):
-        raise ConfigError(f"{where}.params: expected a mapping of parameter: value or "
+        raise ConfigError(f"{where}.params: must be a mapping of parameter: value or "
                           f"[values], got {_short(raw)}")
     fields_by_kind = {k: tuple(f.name for f in dataclasses.fields(sp.params_cls))
                       for k, sp in specs.items()}
@@ -385,7 +385,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
     if isinstance(v, str):
         v = {"map": v}
     if not isinstance(v, Mapping):
-        raise ConfigError(f"{where}: expected a mapping with map (or dynamic) and queries, "
+        raise ConfigError(f"{where}: must be a mapping with map (or dynamic) and queries, "
                           f"got {_short(v)}")
     for k in v:
         if k not in _MAP_KEYS:
@@ -410,7 +410,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                 _check_generate(dyn, f"{where}.dynamic")
             default_name = f"dynamic-{i}"
         else:
-            raise ConfigError(f"{where}.dynamic: expected a scenario file or a mapping, "
+            raise ConfigError(f"{where}.dynamic: must be a scenario file or a mapping, "
                               f"got {_short(dyn)}")
         name = _entry_name(v, where, default_name)
         return MapEntry(index=i, name=name, kind="dynamic", spec=None, family=None,
@@ -436,7 +436,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
     if "scen" in v:
         scen = v["scen"]
         if not isinstance(scen, str):
-            raise ConfigError(f"{where}.scen: expected a .scen file path, got {_short(scen)}")
+            raise ConfigError(f"{where}.scen: must be a .scen file path, got {_short(scen)}")
         sp = Path(scen) if Path(scen).is_absolute() else exp_dir / scen
         if not sp.is_file():
             raise ConfigError(f"{where}.scen: no such file {sp}")
@@ -452,7 +452,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
         q = v["queries"]
         if isinstance(q, Mapping):
             if set(q) - {"random", "min_distance_m"} or "random" not in q:
-                raise ConfigError(f"{where}.queries: expected a list of {{start, goal}} or "
+                raise ConfigError(f"{where}.queries: must be a list of {{start, goal}} or "
                                   f"{{random: N, min_distance_m: D}}, got {_short(dict(q))}")
             n = q["random"]
             if not _is_int(n) or n < 1:
@@ -469,7 +469,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                 qw = f"{where}.queries[{j}]"
                 if isinstance(item, Mapping):
                     if set(item) - {"start", "goal"}:
-                        raise ConfigError(f"{qw}: expected {{start: [x, y], goal: [x, y]}}, "
+                        raise ConfigError(f"{qw}: must be {{start: [x, y], goal: [x, y]}}, "
                                           f"got {_short(dict(item))}")
                     s, g = item.get("start"), item.get("goal")
                     queries.append({"start": _point(s, f"{qw}.start"),
@@ -478,10 +478,10 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                     queries.append({"start": _point(item[0], f"{qw}[0]"),
                                     "goal": _point(item[1], f"{qw}[1]")})
                 else:
-                    raise ConfigError(f"{qw}: expected {{start: [x, y], goal: [x, y]}} or "
+                    raise ConfigError(f"{qw}: must be {{start: [x, y], goal: [x, y]}} or "
                                       f"[[x, y], [x, y]], got {_short(item)}")
         else:
-            raise ConfigError(f"{where}.queries: expected a non-empty list of {{start, goal}} "
+            raise ConfigError(f"{where}.queries: must be a non-empty list of {{start, goal}} "
                               f"or {{random: N}}, got {_short(q)}")
     elif family == "paper":
         from pathfuse.generate import PAPER_GOAL, PAPER_START
@@ -505,7 +505,7 @@ def _check_generate(dyn: Mapping[str, Any], where: str) -> None:
 
     if not set(dyn) <= {"generate", "family_seed"} or "generate" not in dyn \
             or not isinstance(dyn["generate"], Mapping):
-        raise ConfigError(f"{where}: expected {{generate: {{moving: K, speed_range: [lo, hi], "
+        raise ConfigError(f"{where}: must be {{generate: {{moving: K, speed_range: [lo, hi], "
                           f"...}}}} (and optionally family_seed: S), got {_short(dict(dyn))}")
     fs = dyn.get("family_seed")
     if fs is not None and (not _is_int(fs) or fs < 0):
@@ -541,7 +541,7 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
                               ".map / .yaml file; use a mapping such as {image: FILE, "
                               "resolution: 0.05}")
     if not isinstance(m, Mapping):
-        raise ConfigError(f"{where}: expected a map spec mapping, got {_short(m)}")
+        raise ConfigError(f"{where}: must be a map spec mapping, got {_short(m)}")
     fams = [f for f in ALL_FAMILIES if f in m]
     if len(fams) != 1:
         raise ConfigError(f"{where}: name exactly one map family of {', '.join(ALL_FAMILIES)}"
@@ -555,7 +555,7 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
         elif family == "paper" and _is_int(inner) and inner >= 0:
             spec[family] = {"seed": int(inner)}
         elif not isinstance(inner, Mapping):
-            raise ConfigError(f"{where}.{family}: expected a mapping of generator arguments, "
+            raise ConfigError(f"{where}.{family}: must be a mapping of generator arguments, "
                               f"got {_short(inner)}")
         if "seed" in spec[family] and (not _is_int(spec[family]["seed"])
                                        or spec[family]["seed"] < 0):
@@ -576,7 +576,7 @@ def _point(v: Any, where: str) -> list[float]:
     if v is None:
         raise ConfigError(f"{where}: missing (an [x, y] point in metres)")
     if not isinstance(v, (list, tuple)) or len(v) != 2 or not all(_is_num(c) for c in v):
-        raise ConfigError(f"{where}: expected [x, y] (two finite numbers, metres), "
+        raise ConfigError(f"{where}: must be [x, y] (two finite numbers, metres), "
                           f"got {_short(v)}")
     return [float(v[0]), float(v[1])]
 

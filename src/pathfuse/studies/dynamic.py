@@ -111,7 +111,7 @@ class DynamicConfig:
     >>> DynamicConfig(speed_range=(0.8, 0.3))  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    pathfuse.result.ConfigError: speed_range: expected (low, high) with 0 < low <= high ...
+    pathfuse.result.ConfigError: speed_range: must be (low, high) with 0 < low <= high ...
     """
 
     n_seeds: int = 50
@@ -135,16 +135,16 @@ class DynamicConfig:
             return make_params(spec, params, key=key)
 
         if not _is_int(self.n_seeds) or self.n_seeds < 1:
-            raise ConfigError(f"n_seeds: expected a positive integer, got {_shown(self.n_seeds)}")
+            raise ConfigError(f"n_seeds: must be a positive integer, got {_shown(self.n_seeds)}")
         if not _is_int(self.seed) or self.seed < 0:
-            raise ConfigError(f"seed: expected an integer >= 0, got {_shown(self.seed)}")
+            raise ConfigError(f"seed: must be an integer >= 0, got {_shown(self.seed)}")
         try:
             moving = tuple(self.moving)
         except TypeError:
-            raise ConfigError(f"moving: expected a list of integers >= 0, "
+            raise ConfigError(f"moving: must be a list of integers >= 0, "
                               f"got {_shown(self.moving)}") from None
         if not moving or not all(_is_int(k) and k >= 0 for k in moving):
-            raise ConfigError(f"moving: expected a list of integers >= 0, got"
+            raise ConfigError(f"moving: must be a list of integers >= 0, got"
                               f" {_shown(self.moving)}")
         object.__setattr__(self, "moving", tuple(dict.fromkeys(int(k) for k in moving)))
         import inspect
@@ -160,11 +160,11 @@ class DynamicConfig:
         except (TypeError, ValueError):
             ok = False
         if not ok:
-            raise ConfigError(f"speed_range: expected (low, high) with 0 < low <= high m/s, "
+            raise ConfigError(f"speed_range: must be (low, high) with 0 < low <= high m/s, "
                               f"got {_shown(self.speed_range)}")
         object.__setattr__(self, "speed_range", (lo, hi))
         if isinstance(self.planners, str):
-            raise ConfigError(f"planners: expected a list of names, got {_shown(self.planners)}")
+            raise ConfigError(f"planners: must be a list of names, got {_shown(self.planners)}")
         canonical = []
         for n in tuple(self.planners) or tuple(online_planner_names()):
             try:
@@ -174,17 +174,17 @@ class DynamicConfig:
         names = tuple(dict.fromkeys(canonical))
         object.__setattr__(self, "planners", names)
         if not isinstance(self.params, Mapping):
-            raise ConfigError(f"params: expected {{planner: {{key: value}}}}, "
+            raise ConfigError(f"params: must be {{planner: {{key: value}}}}, "
                               f"got {_shown(self.params)}")
         for n, p in self.params.items():
             if n not in names:
                 raise ConfigError(f"params.{n}: not among the planners run "
                                   f"({', '.join(names)})")
             if not isinstance(p, Mapping):
-                raise ConfigError(f"params.{n}: expected a mapping of parameters, got {_shown(p)}")
+                raise ConfigError(f"params.{n}: must be a mapping of parameters, got {_shown(p)}")
             make_online_params(get_online_planner(n), p, key=f"params.{n}")
         if not isinstance(self.robot, Mapping):
-            raise ConfigError(f"robot: expected a robot block {{key: value}}, got {self.robot!r}")
+            raise ConfigError(f"robot: must be a robot block {{key: value}}, got {self.robot!r}")
         from pathfuse.world.robot import parse_robot
 
         parse_robot(dict(self.robot))

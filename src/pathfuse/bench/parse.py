@@ -44,6 +44,7 @@ from pathfuse.bench.spec import (
 )
 from pathfuse.limits import check_count
 from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.validate import point
 from pathfuse.validate import short as _shown
 
 
@@ -575,10 +576,7 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
 def _point(v: Any, where: str) -> list[float]:
     if v is None:
         raise ConfigError(f"{where}: missing (an [x, y] point in metres)")
-    if not isinstance(v, (list, tuple)) or len(v) != 2 or not all(_is_num(c) for c in v):
-        raise ConfigError(f"{where}: must be [x, y] (two finite numbers, metres), "
-                          f"got {_short(v)}")
-    return [float(v[0]), float(v[1])]
+    return list(point(v, where))
 
 
 def _check_queries(entry: MapEntry, grid: Any) -> None:

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.validate import point
 from pathfuse.validate import short as _shown
 
 EXIT_FAIL = 1
@@ -48,16 +49,9 @@ options of a command.
 def parse_point(text: str, what: str) -> tuple[float, float]:
     """``"1.5,2"`` -> (1.5, 2.0); :class:`CliError` naming ``what`` otherwise."""
     parts = [p.strip() for p in str(text).replace(";", ",").split(",")]
-    try:
-        if len(parts) != 2:
-            raise ValueError
-        x, y = float(parts[0]), float(parts[1])
-    except ValueError:
-        raise CliError(f"{what}: must be X,Y (two numbers in metres), got"
-                       f" {_shown(text)}") from None
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise CliError(f"{what}: coordinates must be finite, got {_shown(text)}")
-    return x, y
+    if len(parts) != 2:
+        raise CliError(f"{what}: must be X,Y (two numbers in metres), got {_shown(text)}")
+    return point(parts, what, CliError)
 
 
 def parse_params(items: Sequence[str] | None) -> dict[str, Any]:

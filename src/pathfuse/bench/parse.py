@@ -380,6 +380,71 @@ def _strip_planner(msg: str) -> str:
     return msg
 
 
+def _dynamic_entry(i: int, v: Mapping[str, Any], where: str, seeds: tuple[int, ...],
+                   radius: float, exp_dir: Path) -> MapEntry:
+    """A ``dynamic:`` map entry (a scenario file, or a mapping such as ``generate:``)."""
+    extra = set(v) - {"name", "dynamic", "seeds", "robot_radius_m"}
+    if extra:
+        raise ConfigError(f"{where}.{sorted(extra)[0]}: not used with dynamic "
+                          "(the scenario holds the map and the queries)")
+    dyn = v["dynamic"]
+    if isinstance(dyn, str):
+        dp = Path(dyn) if Path(dyn).is_absolute() else exp_dir / dyn
+        if not dp.is_file():
+            raise ConfigError(f"{where}.dynamic: no such scenario file {dp}")
+        default_name = Path(dyn).stem
+    elif isinstance(dyn, Mapping):
+        dyn = _plain(dict(dyn))
+        if "generate" in dyn:
+            _check_generate(dyn, f"{where}.dynamic")
+        default_name = f"dynamic-{i}"
+    else:
+        raise ConfigError(f"{where}.dynamic: must be a scenario file or a mapping, "
+                          f"got {_short(dyn)}")
+    name = _entry_name(v, where, default_name)
+    return MapEntry(index=i, name=name, kind="dynamic", spec=None, family=None,
+                    seeds=seeds, robot_radius_m=radius, dynamic=dyn)
+
+
+def _queries(q: Any, where: str) -> tuple[list[dict[str, Any]], dict[str, Any] | None]:
+    """``(queries, random_queries)`` of a map entry's ``queries:`` (a list of
+    ``{start, goal}`` or ``[[x, y], [x, y]]``, or ``{random: N, min_distance_m: D}``)."""
+    queries: list[dict[str, Any]] = []
+    if isinstance(q, Mapping):
+        if set(q) - {"random", "min_distance_m"} or "random" not in q:
+            raise ConfigError(f"{where}.queries: must be a list of {{start, goal}} or "
+                              f"{{random: N, min_distance_m: D}}, got {_short(dict(q))}")
+        n = q["random"]
+        if not _is_int(n) or n < 1:
+            raise ConfigError(f"{where}.queries.random: must be an integer >= 1, got"
+                              f" {_shown(n)}")
+        check_count(int(n), "MAX_RUNS", f"{where}.queries.random")
+        d = q.get("min_distance_m", 0.0)
+        if not _is_num(d) or float(d) < 0:
+            raise ConfigError(f"{where}.queries.min_distance_m: must be a number >= 0, "
+                              f"got {_shown(d)}")
+        return queries, {"count": int(n), "min_distance_m": float(d)}
+    if not (isinstance(q, list) and q):
+        raise ConfigError(f"{where}.queries: must be a non-empty list of {{start, goal}} "
+                          f"or {{random: N}}, got {_short(q)}")
+    for j, item in enumerate(q):
+        qw = f"{where}.queries[{j}]"
+        if isinstance(item, Mapping):
+            if set(item) - {"start", "goal"}:
+                raise ConfigError(f"{qw}: must be {{start: [x, y], goal: [x, y]}}, "
+                                  f"got {_short(dict(item))}")
+            s, g = item.get("start"), item.get("goal")
+            queries.append({"start": _point(s, f"{qw}.start"),
+                            "goal": _point(g, f"{qw}.goal")})
+        elif isinstance(item, list) and len(item) == 2:
+            queries.append({"start": _point(item[0], f"{qw}[0]"),
+                            "goal": _point(item[1], f"{qw}[1]")})
+        else:
+            raise ConfigError(f"{qw}: must be {{start: [x, y], goal: [x, y]}} or "
+                              f"[[x, y], [x, y]], got {_short(item)}")
+    return queries, None
+
+
 def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                exp_dir: Path, seeds_overridden: bool) -> MapEntry:
     where = f"maps[{i}]"
@@ -395,27 +460,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
         parse_seeds(v["seeds"], f"{where}.seeds")
     radius = _radius(v.get("robot_radius_m", top_radius), f"{where}.robot_radius_m")
     if "dynamic" in v:
-        extra = set(v) - {"name", "dynamic", "seeds", "robot_radius_m"}
-        if extra:
-            raise ConfigError(f"{where}.{sorted(extra)[0]}: not used with dynamic "
-                              "(the scenario holds the map and the queries)")
-        dyn = v["dynamic"]
-        if isinstance(dyn, str):
-            dp = Path(dyn) if Path(dyn).is_absolute() else exp_dir / dyn
-            if not dp.is_file():
-                raise ConfigError(f"{where}.dynamic: no such scenario file {dp}")
-            default_name = Path(dyn).stem
-        elif isinstance(dyn, Mapping):
-            dyn = _plain(dict(dyn))
-            if "generate" in dyn:
-                _check_generate(dyn, f"{where}.dynamic")
-            default_name = f"dynamic-{i}"
-        else:
-            raise ConfigError(f"{where}.dynamic: must be a scenario file or a mapping, "
-                              f"got {_short(dyn)}")
-        name = _entry_name(v, where, default_name)
-        return MapEntry(index=i, name=name, kind="dynamic", spec=None, family=None,
-                        seeds=seeds, robot_radius_m=radius, dynamic=dyn)
+        return _dynamic_entry(i, v, where, seeds, radius, exp_dir)
     if "map" not in v:
         raise ConfigError(f"{where}.map: missing (a map spec such as paper, "
                           "{movingai: FILE}, {ros: FILE.yaml}; or use dynamic)")
@@ -432,7 +477,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
     if "lines" in v and "scen" not in v:
         raise ConfigError(f"{where}.lines: only used with scen")
     queries: list[dict[str, Any]] = []
-    random_q = None
+    random_q: dict[str, Any] | None = None
     scen = None
     if "scen" in v:
         scen = v["scen"]
@@ -450,40 +495,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
         queries.append({"start": _point(v.get("start"), f"{where}.start"),
                         "goal": _point(v.get("goal"), f"{where}.goal")})
     elif "queries" in v:
-        q = v["queries"]
-        if isinstance(q, Mapping):
-            if set(q) - {"random", "min_distance_m"} or "random" not in q:
-                raise ConfigError(f"{where}.queries: must be a list of {{start, goal}} or "
-                                  f"{{random: N, min_distance_m: D}}, got {_short(dict(q))}")
-            n = q["random"]
-            if not _is_int(n) or n < 1:
-                raise ConfigError(f"{where}.queries.random: must be an integer >= 1, got"
-                                  f" {_shown(n)}")
-            check_count(int(n), "MAX_RUNS", f"{where}.queries.random")
-            d = q.get("min_distance_m", 0.0)
-            if not _is_num(d) or float(d) < 0:
-                raise ConfigError(f"{where}.queries.min_distance_m: must be a number >= 0, "
-                                  f"got {_shown(d)}")
-            random_q = {"count": int(n), "min_distance_m": float(d)}
-        elif isinstance(q, list) and q:
-            for j, item in enumerate(q):
-                qw = f"{where}.queries[{j}]"
-                if isinstance(item, Mapping):
-                    if set(item) - {"start", "goal"}:
-                        raise ConfigError(f"{qw}: must be {{start: [x, y], goal: [x, y]}}, "
-                                          f"got {_short(dict(item))}")
-                    s, g = item.get("start"), item.get("goal")
-                    queries.append({"start": _point(s, f"{qw}.start"),
-                                    "goal": _point(g, f"{qw}.goal")})
-                elif isinstance(item, list) and len(item) == 2:
-                    queries.append({"start": _point(item[0], f"{qw}[0]"),
-                                    "goal": _point(item[1], f"{qw}[1]")})
-                else:
-                    raise ConfigError(f"{qw}: must be {{start: [x, y], goal: [x, y]}} or "
-                                      f"[[x, y], [x, y]], got {_short(item)}")
-        else:
-            raise ConfigError(f"{where}.queries: must be a non-empty list of {{start, goal}} "
-                              f"or {{random: N}}, got {_short(q)}")
+        queries, random_q = _queries(v["queries"], where)
     elif family == "paper":
         from pathfuse.generate import PAPER_GOAL, PAPER_START
 

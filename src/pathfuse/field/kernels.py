@@ -367,6 +367,11 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
     return nx, ny, True, math.hypot(tx - nx, ty - ny) <= 0.5 * step
 
 
+# Long on purpose (~190 lines): Algorithm 2 and pathfuse's escape are one state machine
+# (the modes of ``state[S_MODE]``) whose transitions share a dozen locals (position,
+# progress index, stall reference, escape targets); simulate() enters it once per tick,
+# so split into calls every piece would pass that state in and out.  The force and the
+# step already are helpers (fusion_force, _step, _escape_move, _goal_reached).
 @njit(cache=True)
 def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel, drad):
     """Algorithm 2 steps from ``buf[n-1]`` along the global path ``pts`` (M, 2).

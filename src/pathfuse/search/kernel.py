@@ -130,6 +130,10 @@ def _spop(skey, snode, size):
     return top, size
 
 
+# Long on purpose (~200 lines): the hot loop of every grid search, one function so
+# that numba keeps its state (the open list's heads, the current cell's word and its
+# neighbours') in locals; the pieces that stand alone are already helpers, and
+# tests/test_astar_golden.py pins its paths and expansion counts.
 @njit(cache=True, nogil=True)
 def _astar_kernel(
     cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, gen,

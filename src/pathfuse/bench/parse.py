@@ -44,7 +44,7 @@ from pathfuse.bench.spec import (
 )
 from pathfuse.limits import check_count
 from pathfuse.result import ConfigError, PathfuseError
-from pathfuse.validate import point
+from pathfuse.validate import mapping, point
 from pathfuse.validate import short as _shown
 
 
@@ -118,9 +118,7 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
     if not isinstance(doc, Mapping):
         raise ConfigError(f"the file must hold a mapping with maps and planners, "
                           f"got {type(doc).__name__}")
-    for k in doc:
-        if k not in _TOP_KEYS:
-            raise ConfigError(f"{k}: unknown key; expected one of {', '.join(_TOP_KEYS)}")
+    mapping(doc, "", _TOP_KEYS)
     name = doc.get("name", path.stem)
     if not isinstance(name, str) or not name.strip():
         raise ConfigError(f"name: must be a non-empty string, got {_shown(name)}")
@@ -281,10 +279,7 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
     if not isinstance(v, Mapping):
         raise ConfigError(f"{where}: must be a planner name or a mapping with name/params, "
                           f"got {_short(v)}")
-    for k in v:
-        if k not in _PLANNER_KEYS:
-            raise ConfigError(f"{where}.{k}: unknown key; expected one of "
-                              f"{', '.join(_PLANNER_KEYS)}")
+    mapping(v, where, _PLANNER_KEYS)
     if "name" not in v:
         raise ConfigError(f"{where}.name: missing (the planner's registry name)")
     name = v["name"]
@@ -453,9 +448,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
     if not isinstance(v, Mapping):
         raise ConfigError(f"{where}: must be a mapping with map (or dynamic) and queries, "
                           f"got {_short(v)}")
-    for k in v:
-        if k not in _MAP_KEYS:
-            raise ConfigError(f"{where}.{k}: unknown key; expected one of {', '.join(_MAP_KEYS)}")
+    mapping(v, where, _MAP_KEYS)
     seeds = top_seeds if seeds_overridden or "seeds" not in v else \
         parse_seeds(v["seeds"], f"{where}.seeds")
     radius = _radius(v.get("robot_radius_m", top_radius), f"{where}.robot_radius_m")

@@ -345,8 +345,7 @@ def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[st
         files["parameters_csv"].write_text(
             "scope,kind,planner,parameter,value,configs,runs\n", encoding="utf-8")
 
-    sections = (_entry_sections(rep, out, dpi, files) + _pooled_sections(rep, out, dpi, files)
-                + _parameter_sections(rep, out, dpi, files))
+    sections = _map_sections(rep, out, dpi, files) + _parameter_sections(rep, out, dpi, files)
 
     head = _header(study, ref_label, swept)
     files["report_md"].write_text(_markdown(head, sections), encoding="utf-8")
@@ -355,9 +354,10 @@ def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[st
     return files
 
 
-def _entry_sections(rep: StudyReport, out: Path, dpi: int,
-                    files: dict[str, Path]) -> list[_Section]:
-    """A section per map entry: its table and box plots (added to ``files``)."""
+def _map_sections(rep: StudyReport, out: Path, dpi: int,
+                  files: dict[str, Path]) -> list[_Section]:
+    """A section per map entry (its table and box plots, added to ``files``), then one per
+    kind with several entries, pooled."""
     study, rl, ref_label = rep.study, rep.r_length, rep.reference_label
     rows = rep.rows
     from pathfuse.viz import report as viz
@@ -418,17 +418,6 @@ def _entry_sections(rep: StudyReport, out: Path, dpi: int,
             files[f"r_length_{slug}"] = out / name
             sec.images.append((name, f"R_length against {ref_label} (paired runs)"))
         sections.append(sec)
-    return sections
-
-
-def _pooled_sections(rep: StudyReport, out: Path, dpi: int,
-                     files: dict[str, Path]) -> list[_Section]:
-    """A section per kind with several map entries, pooled."""
-    study, rl, ref_label = rep.study, rep.r_length, rep.reference_label
-    rows = rep.rows
-    from pathfuse.viz import report as viz
-
-    sections: list[_Section] = []
     for scope, kind, _, pooled in _scopes(study):
         if not pooled:
             continue

@@ -319,9 +319,9 @@ def test_bad_queries_through_plan(den):
     assert Problem.create(den, wall, ok).failure()[0] is Status.START_OCCUPIED
     assert Problem.create(den, ok, out).failure()[0] is Status.GOAL_OUT_OF_BOUNDS
     assert Problem.create(den, ok, ok).failure() is None
-    with pytest.raises(QueryError, match=r"^goal: must be finite, got"):
+    with pytest.raises(QueryError, match=r"^goal\[1\]: must be a finite number, got inf"):
         Problem.create(den, ok, (1.0, np.inf))
-    with pytest.raises(QueryError, match=r"^goal: must be two numbers \(x, y\), got"):
+    with pytest.raises(QueryError, match=r"^goal: must be two numbers \[x, y\], got"):
         pathfuse.plan(den, ok, (1.0, 2.0, 3.0))
 
 

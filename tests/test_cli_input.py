@@ -214,7 +214,7 @@ def test_scen_with_only_a_header(tmp_path):
 
 def test_scen_arguments_swapped():
     proc = run("scen", DATA / "movingai" / "den312d.map.scen", DATA / "movingai" / "den312d.map")
-    one_line(proc, 2, "expected header 'type octile', got 'version 1'",
+    one_line(proc, 2, "must be the header 'type octile', got 'version 1'",
              "this is a MovingAI scenario file (.scen), not a map: give the .map first")
 
 

@@ -253,7 +253,7 @@ BAD = [
     ("planners: [xsweep]\nmaps: [{map: {rows: ['...']}, start: [0.5, 0.5], goal: [9, 0.5]}]\n",
      "maps[0].goal: (9, 0.5) lies outside map"),
     ("planners: [xsweep]\nmaps: [{map: {rows: ['..']}, start: [0.5], goal: [1, 0.5]}]\n",
-     "maps[0].start: expected [x, y]"),
+     "maps[0].start: must be two numbers [x, y]"),
     ("planners: [xsweep]\nmaps: [paper, paper]\n", "maps[1].name: 'paper' is already the name"),
     ("planners: [xsweep]\nmaps: [{map: {random: {size: [5, 5], density: 2}}, "
      "queries: {random: 1}}]\n", "maps[0].map: "),

@@ -185,10 +185,10 @@ CYL = "<cylinder><radius>0.5</radius><length>1</length></cylinder>"
     (_model(CYL, pose="0 0 0.5 0.3 0 0"), "tilted <cylinder>"),
     (_model("<cylinder><radius>-1</radius><length>1</length></cylinder>"), "must be > 0"),
     (_model("<cylinder><radius>abc</radius><length>1</length></cylinder>"),
-     "expected numbers"),
-    (_model("<box><size>1 1</size></box>"), "expected 3 finite numbers"),
+     "must be numbers"),
+    (_model("<box><size>1 1</size></box>"), "must be 3 finite numbers"),
     (_model(CYL, pose="0 0 nan 0 0 0"), "finite numbers"),
-    (_model(CYL, pose="1 2 3"), "expected 6 finite numbers"),
+    (_model(CYL, pose="1 2 3"), "must be 6 finite numbers"),
     ("<model name='m'><static>1</static><link name='l'><collision name='c'>"
      "</collision></link></model>", "no <geometry>"),
     ("<include><uri>model://bookshelf</uri></include>", "cannot be resolved"),

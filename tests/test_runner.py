@@ -388,9 +388,9 @@ def test_bad_arguments_are_config_errors(tmp_path):
     db = tmp_path / "never.db"
     for kw, msg in ((dict(workers=0), "workers: must be an integer >= 1"),
                     (dict(workers=1.5), "workers: must be an integer >= 1"),
-                    (dict(scheduler="localhost:8786"), "scheduler: expected an address"),
+                    (dict(scheduler="localhost:8786"), "scheduler: must be an address"),
                     (dict(batch_size=0), "batch_size: must be an integer >= 1"),
-                    (dict(seeds="x"), "seeds (override): expected")):
+                    (dict(seeds="x"), "seeds (override): must be")):
         with pytest.raises(ConfigError, match=msg.replace("(", r"\(").replace(")", r"\)")):
             run_bench(exp, db, progress=False, **kw)
     assert not db.exists()

@@ -11,6 +11,7 @@ import pytest
 
 from pathfuse import ConfigError, GridMap, MapError, MapFormatError, Status
 from pathfuse.planners.registry import planner_names
+from pathfuse.sweep import segment_static_distance
 from pathfuse.world import (
     LinearObstacle,
     PatrolObstacle,
@@ -21,7 +22,6 @@ from pathfuse.world import (
     simulate,
 )
 from pathfuse.world.generate import generate_scenarios
-from pathfuse.world.geometry import segment_static_distance
 
 DATA = Path(__file__).parent / "data" / "scenarios"
 EXAMPLES = Path(__file__).parent.parent / "examples" / "scenarios"

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from pathfuse import GridMap, QueryError
 from pathfuse.result import PathfuseError
+from pathfuse.sweep import disc_sweep_gaps, segment_static_distance
 from pathfuse.world import (
     LinearObstacle,
     PatrolObstacle,
@@ -18,7 +19,6 @@ from pathfuse.world import (
     World,
     load_scenario,
 )
-from pathfuse.world.geometry import disc_sweep_gaps, segment_static_distance
 
 # ----------------------------------------------------------------------------- oracles
 # Independent of the code under test: a segment/box distance by the separating-axis

@@ -29,38 +29,12 @@ from typing import Any
 
 from pathfuse.grid import GridMap
 from pathfuse.result import Budget, ConfigError, QueryError, Status
+from pathfuse.validate import point
 from pathfuse.validate import short as _shown
 
-__all__ = ["Problem", "as_xy"]
+__all__ = ["Problem"]
 
 _DEFAULT_BUDGET = Budget()
-
-
-def as_xy(value: object, what: str) -> tuple[float, float]:
-    """A finite ``(x, y)`` pair of floats, or :class:`QueryError` naming ``what``.
-
-    >>> as_xy((1, 2.5), "start")
-    (1.0, 2.5)
-    >>> as_xy("12", "goal")
-    Traceback (most recent call last):
-    ...
-    pathfuse.result.QueryError: goal: must be two numbers (x, y), got '12'
-    """
-    if isinstance(value, (str, bytes)):
-        raise QueryError(f"{what}: must be two numbers (x, y), got {_shown(value)}")
-    x: Any
-    y: Any
-    try:
-        x, y = value  # type: ignore[misc]
-        x = float(x)
-        y = float(y)
-    except (TypeError, ValueError, OverflowError):
-        shown = repr(value)
-        shown = shown if len(shown) <= 60 else shown[:57] + "..."
-        raise QueryError(f"{what}: must be two numbers (x, y), got {shown}") from None
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise QueryError(f"{what}: must be finite, got {_shown(value)}")
-    return x, y
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,8 +101,8 @@ class Problem:
         """
         if not isinstance(grid, GridMap):
             raise QueryError(f"grid: must be a pathfuse.GridMap, got {type(grid).__name__}")
-        s = as_xy(start, "start")
-        g = as_xy(goal, "goal")
+        s = point(start, "start", QueryError)
+        g = point(goal, "goal", QueryError)
         if budget is None:
             budget = _DEFAULT_BUDGET
         elif not isinstance(budget, Budget):

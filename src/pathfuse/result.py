@@ -27,6 +27,16 @@ __all__ = [
     "QueryError",
     "ConfigError",
     "PlanningFailed",
+    "CODE_SUCCESS",
+    "CODE_NO_PATH",
+    "CODE_LOCAL_MINIMUM",
+    "CODE_MAX_ITERATIONS",
+    "CODE_TIMEOUT",
+    "CODE_COLLISION",
+    "CODE_RUNNING",
+    "CODE_GROW",
+    "refined",
+    "code_outcome",
 ]
 
 
@@ -75,6 +85,98 @@ class Status(enum.Enum):
     @property
     def ok(self) -> bool:
         return self is Status.SUCCESS
+
+    @property
+    def code(self) -> int:
+        """The integer a numba kernel returns for this outcome: its place in the enum
+        (see :data:`CODE_SUCCESS` and the other ``CODE_*`` below).
+
+        >>> Status.SUCCESS.code, Status.COLLISION.code
+        (0, 9)
+        """
+        return _CODES[self]
+
+    @property
+    def key(self) -> str:
+        """The lowercase word for this outcome in :meth:`pathfuse.world.World.step`'s
+        ``event`` and in the moving-obstacle study's rows: the value, except
+        ``"reached"`` for ``SUCCESS`` (the word both have always used).
+
+        >>> Status.SUCCESS.key, Status.COLLISION.key, Status.LOCAL_MINIMUM.key
+        ('reached', 'collision', 'local_minimum')
+        """
+        return "reached" if self is Status.SUCCESS else self.value
+
+    @property
+    def label(self) -> str:
+        """The outcome's words in a table heading.
+
+        >>> Status.SUCCESS.label, Status.LOCAL_MINIMUM.label, Status.NO_PATH.label
+        ('success', 'local min', 'no path')
+        """
+        return "local min" if self is Status.LOCAL_MINIMUM else self.value.replace("_", " ")
+
+    @classmethod
+    def from_key(cls, key: str) -> Status:
+        """The status whose :attr:`key` is ``key``.
+
+        >>> Status.from_key("reached")
+        <Status.SUCCESS: 'success'>
+        """
+        for s in cls:
+            if s.key == key:
+                return s
+        raise ValueError(f"outcome: must be one of {[s.key for s in cls]}, got {key!r}")
+
+
+_CODES: dict[Status, int] = {s: i for i, s in enumerate(Status)}
+_BY_CODE: tuple[Status, ...] = tuple(Status)
+
+# --- The integer outcome codes of the numba kernels (numba compiles module-level ints
+# as constants and cannot return an Enum).  Every code a kernel returns is one of:
+# a status's code (its place in the enum), a refinement of one (``refined``: a second
+# way of ending with that status that the caller words apart), or a negative code
+# for a loop that paused without an outcome.  New members go at the end of Status:
+# numba's cache keys a kernel on its own file, so renumbering these needs the
+# caches cleared (tests/test_outcome_codes.py pins the numbers).
+CODE_SUCCESS = Status.SUCCESS.code
+CODE_NO_PATH = Status.NO_PATH.code
+CODE_LOCAL_MINIMUM = Status.LOCAL_MINIMUM.code
+CODE_MAX_ITERATIONS = Status.MAX_ITERATIONS.code
+CODE_TIMEOUT = Status.TIMEOUT.code
+CODE_COLLISION = Status.COLLISION.code
+#: Paused at a step or clock cap: call again.
+CODE_RUNNING = -1
+#: Paused because a buffer (the open list) is full: grow it and call again.
+CODE_GROW = -2
+#: The distance between a status's code and its refinements.
+REFINE_STEP = 100
+
+
+def refined(code: int, k: int = 1) -> int:
+    """The ``k``-th refinement of the status code ``code``.
+
+    >>> refined(CODE_LOCAL_MINIMUM), code_outcome(refined(CODE_LOCAL_MINIMUM))
+    (106, <Status.LOCAL_MINIMUM: 'local_minimum'>)
+    """
+    if not 0 <= code < len(_BY_CODE) or k < 1:
+        raise ValueError(f"code: must be a status code with k >= 1, got {code!r}, k={k!r}")
+    return code + k * REFINE_STEP
+
+
+def code_outcome(code: int) -> Status | None:
+    """The :class:`Status` a kernel's code (or refinement) stands for; ``None`` for a
+    paused loop (negative code).
+
+    >>> code_outcome(CODE_NO_PATH), code_outcome(CODE_RUNNING)
+    (<Status.NO_PATH: 'no_path'>, None)
+    """
+    if code < 0:
+        return None
+    s = code % REFINE_STEP
+    if s >= len(_BY_CODE):
+        raise ValueError(f"code: must be a kernel outcome code, got {code!r}")
+    return _BY_CODE[s]
 
 
 @dataclass(frozen=True)

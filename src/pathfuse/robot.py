@@ -151,9 +151,3 @@ class RobotModel:
     def replace(self, **changes: Any) -> RobotModel:
         """A copy with some fields changed (checked again)."""
         return dataclasses.replace(self, **changes)
-
-    def braking_distance_m(self, speed_mps: float) -> float:
-        """Distance to stop from ``speed_mps`` at the acceleration limit (0 without one)."""
-        if math.isinf(self.max_accel_mps2):
-            return 0.0
-        return speed_mps * speed_mps / (2.0 * self.max_accel_mps2)

@@ -32,6 +32,10 @@ Examples
 >>> x, y, th = unicycle_pose(0.0, 0.0, 0.0, 1.0, np.pi / 2, 1.0)  # a quarter circle, R = 2/pi
 >>> round(x, 9), round(y, 9), round(th, 9)
 (0.636619772, 0.636619772, 1.570796327)
+>>> gaps = disc_sweep_gaps(np.array([0.0, 0.0]), np.array([2.0, 0.0]), 0.2,
+...                        np.array([[1.0, 1.0]]), np.array([[1.0, -1.0]]), np.array([0.3]))
+>>> round(float(gaps[0]), 6)    # both cross (1, 0) at mid-tick
+-0.5
 """
 
 from __future__ import annotations

@@ -39,7 +39,7 @@ import re
 from collections.abc import Mapping, Sequence
 from typing import Any, TypeVar
 
-from pathfuse.result import ConfigError
+from pathfuse.result import ConfigError, PathfuseError
 
 __all__ = [
     "SHOWN",
@@ -103,7 +103,8 @@ def _make_repr() -> Any:
 _REPR = _make_repr()
 
 
-def _fail(key: str, what: str, value: Any, error: type[ConfigError]) -> ConfigError:
+def _fail(key: str, what: str, value: Any,
+          error: type[ConfigError] | type[PathfuseError]) -> PathfuseError:
     return error(f"{key}: must be {what}, got {short(value)}")
 
 
@@ -129,7 +130,7 @@ def _bounds(gt: float | None, ge: float | None, lt: float | None, le: float | No
 
 def number(value: Any, key: str, *, gt: float | None = None, ge: float | None = None,
            lt: float | None = None, le: float | None = None,
-           error: type[ConfigError] = ConfigError) -> float:
+           error: type[ConfigError] | type[PathfuseError] = ConfigError) -> float:
     """A finite float within the bounds; numeric strings such as ``"1e-2"`` are accepted.
 
     >>> number(3, "k_att", gt=0)
@@ -200,17 +201,28 @@ def text(value: Any, key: str, error: type[ConfigError] = ConfigError) -> str:
     raise _fail(key, "a string", value, error)
 
 
-def point(value: Any, key: str, error: type[ConfigError] = ConfigError) -> tuple[float, float]:
-    """Two finite numbers ``[x, y]``.
+def point(value: Any, key: str,
+          error: type[ConfigError] | type[PathfuseError] = ConfigError) -> tuple[float, float]:
+    """Two finite numbers ``[x, y]``: a list, a tuple or an array of two (numbers, numpy
+    scalars or numeric strings).  The one point check of every caller: files, web
+    requests, :meth:`pathfuse.problem.Problem.create` (``error`` :class:`QueryError`)
+    and the command line (``--start X,Y``, split on the comma first).
 
     >>> point([1, "2.5"], "start")
     (1.0, 2.5)
+    >>> point((1.0, float("inf")), "goal")
+    Traceback (most recent call last):
+    ...
+    pathfuse.result.ConfigError: goal[1]: must be a finite number, got inf
     """
     if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):
         value = value.tolist()
     if not isinstance(value, (list, tuple)) or len(value) != 2:
         raise _fail(key, "two numbers [x, y]", value, error)
-    return (number(value[0], f"{key}[0]", error=error), number(value[1], f"{key}[1]", error=error))
+    x, y = value
+    if type(x) is float and type(y) is float and math.isfinite(x) and math.isfinite(y):
+        return x, y  # the common case, without the general checks (plan() calls this)
+    return (number(x, f"{key}[0]", error=error), number(y, f"{key}[1]", error=error))
 
 
 def mapping(value: Any, key: str, allowed: Sequence[str] | None = None, what: str = "a mapping",

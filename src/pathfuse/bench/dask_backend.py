@@ -66,7 +66,7 @@ def connect_dask(scheduler: Any) -> tuple[Any, bool]:
     if isinstance(scheduler, distributed.Client):
         return scheduler, False
     if not isinstance(scheduler, str) or "://" not in scheduler:
-        raise ConfigError(f"scheduler: expected an address like tcp://HOST:8786, "
+        raise ConfigError(f"scheduler: must be an address like tcp://HOST:8786, "
                           f"got {scheduler!r}")
     _probe(scheduler)
     try:

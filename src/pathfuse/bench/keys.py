@@ -155,7 +155,7 @@ def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
             else:
                 seeds = tuple(int(t) for t in text.split(",") if t.strip())
         except ValueError:
-            raise bad(f"expected 'A:B', 'A,B,C' or a count, got {_shown(value)}") from None
+            raise bad(f"must be 'A:B', 'A,B,C' or a count, got {_shown(value)}") from None
         if ":" in text:
             if b <= a:
                 raise bad(f"{_shown(value)} holds no seed")
@@ -168,7 +168,7 @@ def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
     if isinstance(value, Mapping):
         unknown = set(value) - {"start", "count"}
         if unknown or "count" not in value:
-            raise bad(f"expected {{start: A, count: N}}, got {_short(dict(value))}")
+            raise bad(f"must be {{start: A, count: N}}, got {_short(dict(value))}")
         start, count = value.get("start", 0), value["count"]
         if not _is_int(start) or start < 0:
             raise bad(f"start must be an integer >= 0, got {_shown(start)}")
@@ -186,7 +186,7 @@ def parse_seeds(value: Any, where: str = "seeds") -> tuple[int, ...]:
         if len(set(value)) != len(value):
             raise bad("the seed list repeats a seed")
         return tuple(int(s) for s in value)
-    raise bad(f"expected a count, a list of integers, 'A:B' or {{start, count}}, "
+    raise bad(f"must be a count, a list of integers, 'A:B' or {{start, count}}, "
               f"got {_shown(value)}")
 
 
@@ -210,7 +210,7 @@ def _parse_limits(value: Any, where: str, base: Limits | None = None) -> Limits:
     if value is None:
         return base
     if not isinstance(value, Mapping):
-        raise ConfigError(f"{where}: expected a mapping {{time_limit_s, max_iterations}}, "
+        raise ConfigError(f"{where}: must be a mapping {{time_limit_s, max_iterations}}, "
                           f"got {_short(value)}")
     for k in value:
         if k not in _LIMIT_KEYS:

@@ -45,6 +45,7 @@ from pathfuse.bench.spec import (
 )
 from pathfuse.limits import check_count
 from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.validate import mapping, point
 from pathfuse.validate import short as _shown
 
 
@@ -118,9 +119,7 @@ def _parse(doc: Any, path: Path, text: str, seeds_override: Any,
     if not isinstance(doc, Mapping):
         raise ConfigError(f"the file must hold a mapping with maps and planners, "
                           f"got {type(doc).__name__}")
-    for k in doc:
-        if k not in _TOP_KEYS:
-            raise ConfigError(f"{k}: unknown key; expected one of {', '.join(_TOP_KEYS)}")
+    mapping(doc, "", _TOP_KEYS)
     name = doc.get("name", path.stem)
     if not isinstance(name, str) or not name.strip():
         raise ConfigError(f"name: must be a non-empty string, got {_shown(name)}")
@@ -226,7 +225,7 @@ def _parse_reference(v: Any) -> dict[str, Any] | None:
     if isinstance(v, str):
         v = {"planner": v}
     if not isinstance(v, Mapping) or "planner" not in v or set(v) - {"planner", "params"}:
-        raise ConfigError(f"reference: expected a planner name or {{planner, params}}, "
+        raise ConfigError(f"reference: must be a planner name or {{planner, params}}, "
                           f"got {_short(v)}")
     try:
         spec = get_planner(v["planner"])
@@ -280,12 +279,9 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
     if isinstance(v, str):
         v = {"name": v}
     if not isinstance(v, Mapping):
-        raise ConfigError(f"{where}: expected a planner name or a mapping with name/params, "
+        raise ConfigError(f"{where}: must be a planner name or a mapping with name/params, "
                           f"got {_short(v)}")
-    for k in v:
-        if k not in _PLANNER_KEYS:
-            raise ConfigError(f"{where}.{k}: unknown key; expected one of "
-                              f"{', '.join(_PLANNER_KEYS)}")
+    mapping(v, where, _PLANNER_KEYS)
     if "name" not in v:
         raise ConfigError(f"{where}.name: missing (the planner's registry name)")
     name = v["name"]
@@ -294,7 +290,7 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         want = [want] if isinstance(want, str) else want
         if not isinstance(want, list) or not want or \
                 not set(want) <= {"static", "dynamic", "irsim"}:
-            raise ConfigError(f"{where}.kinds: expected a list of static / dynamic / irsim, "
+            raise ConfigError(f"{where}.kinds: must be a list of static / dynamic / irsim, "
                               f"got {_short(v['kinds'])}")
         kinds = [k for k in kinds if k in want]
     specs: dict[str, Any] = {}
@@ -320,7 +316,7 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         raise ConfigError(f"{where}.label: must be a non-empty string, got {_shown(label)}")
     raw = v.get("params") or {}
     if not isinstance(raw, Mapping):
-        raise ConfigError(f"{where}.params: expected a mapping of parameter: value or "
+        raise ConfigError(f"{where}.params: must be a mapping of parameter: value or "
                           f"[values], got {_short(raw)}")
     fields_by_kind = {k: tuple(f.name for f in dataclasses.fields(sp.params_cls))
                       for k, sp in specs.items()}
@@ -381,42 +377,85 @@ def _strip_planner(msg: str) -> str:
     return msg
 
 
+def _dynamic_entry(i: int, v: Mapping[str, Any], where: str, seeds: tuple[int, ...],
+                   radius: float, exp_dir: Path) -> MapEntry:
+    """A ``dynamic:`` map entry (a scenario file, or a mapping such as ``generate:``)."""
+    extra = set(v) - {"name", "dynamic", "seeds", "robot_radius_m"}
+    if extra:
+        raise ConfigError(f"{where}.{sorted(extra)[0]}: not used with dynamic "
+                          "(the scenario holds the map and the queries)")
+    dyn = v["dynamic"]
+    if isinstance(dyn, str):
+        dp = Path(dyn) if Path(dyn).is_absolute() else exp_dir / dyn
+        if not dp.is_file():
+            raise ConfigError(f"{where}.dynamic: no such scenario file {dp}")
+        default_name = Path(dyn).stem
+    elif isinstance(dyn, Mapping):
+        dyn = _plain(dict(dyn))
+        if "generate" in dyn:
+            _check_generate(dyn, f"{where}.dynamic")
+        default_name = f"dynamic-{i}"
+    else:
+        raise ConfigError(f"{where}.dynamic: must be a scenario file or a mapping, "
+                          f"got {_short(dyn)}")
+    name = _entry_name(v, where, default_name)
+    return MapEntry(index=i, name=name, kind="dynamic", spec=None, family=None,
+                    seeds=seeds, robot_radius_m=radius, dynamic=dyn)
+
+
+def _queries(q: Any, where: str) -> tuple[list[dict[str, Any]], dict[str, Any] | None]:
+    """``(queries, random_queries)`` of a map entry's ``queries:`` (a list of
+    ``{start, goal}`` or ``[[x, y], [x, y]]``, or ``{random: N, min_distance_m: D}``)."""
+    queries: list[dict[str, Any]] = []
+    if isinstance(q, Mapping):
+        if set(q) - {"random", "min_distance_m"} or "random" not in q:
+            raise ConfigError(f"{where}.queries: must be a list of {{start, goal}} or "
+                              f"{{random: N, min_distance_m: D}}, got {_short(dict(q))}")
+        n = q["random"]
+        if not _is_int(n) or n < 1:
+            raise ConfigError(f"{where}.queries.random: must be an integer >= 1, got"
+                              f" {_shown(n)}")
+        check_count(int(n), "MAX_RUNS", f"{where}.queries.random")
+        d = q.get("min_distance_m", 0.0)
+        if not _is_num(d) or float(d) < 0:
+            raise ConfigError(f"{where}.queries.min_distance_m: must be a number >= 0, "
+                              f"got {_shown(d)}")
+        return queries, {"count": int(n), "min_distance_m": float(d)}
+    if not (isinstance(q, list) and q):
+        raise ConfigError(f"{where}.queries: must be a non-empty list of {{start, goal}} "
+                          f"or {{random: N}}, got {_short(q)}")
+    for j, item in enumerate(q):
+        qw = f"{where}.queries[{j}]"
+        if isinstance(item, Mapping):
+            if set(item) - {"start", "goal"}:
+                raise ConfigError(f"{qw}: must be {{start: [x, y], goal: [x, y]}}, "
+                                  f"got {_short(dict(item))}")
+            s, g = item.get("start"), item.get("goal")
+            queries.append({"start": _point(s, f"{qw}.start"),
+                            "goal": _point(g, f"{qw}.goal")})
+        elif isinstance(item, list) and len(item) == 2:
+            queries.append({"start": _point(item[0], f"{qw}[0]"),
+                            "goal": _point(item[1], f"{qw}[1]")})
+        else:
+            raise ConfigError(f"{qw}: must be {{start: [x, y], goal: [x, y]}} or "
+                              f"[[x, y], [x, y]], got {_short(item)}")
+    return queries, None
+
+
 def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                exp_dir: Path, seeds_overridden: bool) -> MapEntry:
     where = f"maps[{i}]"
     if isinstance(v, str):
         v = {"map": v}
     if not isinstance(v, Mapping):
-        raise ConfigError(f"{where}: expected a mapping with map (or dynamic) and queries, "
+        raise ConfigError(f"{where}: must be a mapping with map (or dynamic) and queries, "
                           f"got {_short(v)}")
-    for k in v:
-        if k not in _MAP_KEYS:
-            raise ConfigError(f"{where}.{k}: unknown key; expected one of {', '.join(_MAP_KEYS)}")
+    mapping(v, where, _MAP_KEYS)
     seeds = top_seeds if seeds_overridden or "seeds" not in v else \
         parse_seeds(v["seeds"], f"{where}.seeds")
     radius = _radius(v.get("robot_radius_m", top_radius), f"{where}.robot_radius_m")
     if "dynamic" in v:
-        extra = set(v) - {"name", "dynamic", "seeds", "robot_radius_m"}
-        if extra:
-            raise ConfigError(f"{where}.{sorted(extra)[0]}: not used with dynamic "
-                              "(the scenario holds the map and the queries)")
-        dyn = v["dynamic"]
-        if isinstance(dyn, str):
-            dp = Path(dyn) if Path(dyn).is_absolute() else exp_dir / dyn
-            if not dp.is_file():
-                raise ConfigError(f"{where}.dynamic: no such scenario file {dp}")
-            default_name = Path(dyn).stem
-        elif isinstance(dyn, Mapping):
-            dyn = _plain(dict(dyn))
-            if "generate" in dyn:
-                _check_generate(dyn, f"{where}.dynamic")
-            default_name = f"dynamic-{i}"
-        else:
-            raise ConfigError(f"{where}.dynamic: expected a scenario file or a mapping, "
-                              f"got {_short(dyn)}")
-        name = _entry_name(v, where, default_name)
-        return MapEntry(index=i, name=name, kind="dynamic", spec=None, family=None,
-                        seeds=seeds, robot_radius_m=radius, dynamic=dyn)
+        return _dynamic_entry(i, v, where, seeds, radius, exp_dir)
     if "map" not in v:
         raise ConfigError(f"{where}.map: missing (a map spec such as paper, "
                           "{movingai: FILE}, {ros: FILE.yaml}; or use dynamic)")
@@ -433,12 +472,12 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
     if "lines" in v and "scen" not in v:
         raise ConfigError(f"{where}.lines: only used with scen")
     queries: list[dict[str, Any]] = []
-    random_q = None
+    random_q: dict[str, Any] | None = None
     scen = None
     if "scen" in v:
         scen = v["scen"]
         if not isinstance(scen, str):
-            raise ConfigError(f"{where}.scen: expected a .scen file path, got {_short(scen)}")
+            raise ConfigError(f"{where}.scen: must be a .scen file path, got {_short(scen)}")
         sp = Path(scen) if Path(scen).is_absolute() else exp_dir / scen
         if not sp.is_file():
             from pathfuse.datasets import missing_hint
@@ -452,40 +491,7 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
         queries.append({"start": _point(v.get("start"), f"{where}.start"),
                         "goal": _point(v.get("goal"), f"{where}.goal")})
     elif "queries" in v:
-        q = v["queries"]
-        if isinstance(q, Mapping):
-            if set(q) - {"random", "min_distance_m"} or "random" not in q:
-                raise ConfigError(f"{where}.queries: expected a list of {{start, goal}} or "
-                                  f"{{random: N, min_distance_m: D}}, got {_short(dict(q))}")
-            n = q["random"]
-            if not _is_int(n) or n < 1:
-                raise ConfigError(f"{where}.queries.random: must be an integer >= 1, got"
-                                  f" {_shown(n)}")
-            check_count(int(n), "MAX_RUNS", f"{where}.queries.random")
-            d = q.get("min_distance_m", 0.0)
-            if not _is_num(d) or float(d) < 0:
-                raise ConfigError(f"{where}.queries.min_distance_m: must be a number >= 0, "
-                                  f"got {_shown(d)}")
-            random_q = {"count": int(n), "min_distance_m": float(d)}
-        elif isinstance(q, list) and q:
-            for j, item in enumerate(q):
-                qw = f"{where}.queries[{j}]"
-                if isinstance(item, Mapping):
-                    if set(item) - {"start", "goal"}:
-                        raise ConfigError(f"{qw}: expected {{start: [x, y], goal: [x, y]}}, "
-                                          f"got {_short(dict(item))}")
-                    s, g = item.get("start"), item.get("goal")
-                    queries.append({"start": _point(s, f"{qw}.start"),
-                                    "goal": _point(g, f"{qw}.goal")})
-                elif isinstance(item, list) and len(item) == 2:
-                    queries.append({"start": _point(item[0], f"{qw}[0]"),
-                                    "goal": _point(item[1], f"{qw}[1]")})
-                else:
-                    raise ConfigError(f"{qw}: expected {{start: [x, y], goal: [x, y]}} or "
-                                      f"[[x, y], [x, y]], got {_short(item)}")
-        else:
-            raise ConfigError(f"{where}.queries: expected a non-empty list of {{start, goal}} "
-                              f"or {{random: N}}, got {_short(q)}")
+        queries, random_q = _queries(v["queries"], where)
     elif family == "paper":
         from pathfuse.generate import PAPER_GOAL, PAPER_START
 
@@ -508,7 +514,7 @@ def _check_generate(dyn: Mapping[str, Any], where: str) -> None:
 
     if not set(dyn) <= {"generate", "family_seed"} or "generate" not in dyn \
             or not isinstance(dyn["generate"], Mapping):
-        raise ConfigError(f"{where}: expected {{generate: {{moving: K, speed_range: [lo, hi], "
+        raise ConfigError(f"{where}: must be {{generate: {{moving: K, speed_range: [lo, hi], "
                           f"...}}}} (and optionally family_seed: S), got {_short(dict(dyn))}")
     fs = dyn.get("family_seed")
     if fs is not None and (not _is_int(fs) or fs < 0):
@@ -544,7 +550,7 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
                               ".map / .yaml file; use a mapping such as {image: FILE, "
                               "resolution: 0.05}")
     if not isinstance(m, Mapping):
-        raise ConfigError(f"{where}: expected a map spec mapping, got {_short(m)}")
+        raise ConfigError(f"{where}: must be a map spec mapping, got {_short(m)}")
     fams = [f for f in ALL_FAMILIES if f in m]
     if len(fams) != 1:
         raise ConfigError(f"{where}: name exactly one map family of {', '.join(ALL_FAMILIES)}"
@@ -558,7 +564,7 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
         elif family == "paper" and _is_int(inner) and inner >= 0:
             spec[family] = {"seed": int(inner)}
         elif not isinstance(inner, Mapping):
-            raise ConfigError(f"{where}.{family}: expected a mapping of generator arguments, "
+            raise ConfigError(f"{where}.{family}: must be a mapping of generator arguments, "
                               f"got {_short(inner)}")
         if "seed" in spec[family] and (not _is_int(spec[family]["seed"])
                                        or spec[family]["seed"] < 0):
@@ -580,10 +586,7 @@ def _parse_map_spec(m: Any, where: str, exp_dir: Path) -> tuple[dict[str, Any], 
 def _point(v: Any, where: str) -> list[float]:
     if v is None:
         raise ConfigError(f"{where}: missing (an [x, y] point in metres)")
-    if not isinstance(v, (list, tuple)) or len(v) != 2 or not all(_is_num(c) for c in v):
-        raise ConfigError(f"{where}: expected [x, y] (two finite numbers, metres), "
-                          f"got {_short(v)}")
-    return [float(v[0]), float(v[1])]
+    return list(point(v, where))
 
 
 def _check_queries(entry: MapEntry, grid: Any) -> None:

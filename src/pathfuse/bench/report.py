@@ -325,14 +325,12 @@ def build_report(db_path: str | Path, reference: str | None = None,
 
 
 def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[str, Path]:
-    study, rl, ref_label, swept = rep.study, rep.r_length, rep.reference_label, rep.swept
+    study, ref_label, swept = rep.study, rep.reference_label, rep.swept
     rows, prows = rep.rows, rep.parameter_rows
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise ConfigError(f"{out}: cannot create the output folder ({exc.strerror})") from None
-    from pathfuse.viz import report as viz
-
     files: dict[str, Path] = {
         "report_md": out / "report.md",
         "report_html": out / "report.html",
@@ -346,6 +344,23 @@ def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[st
     else:
         files["parameters_csv"].write_text(
             "scope,kind,planner,parameter,value,configs,runs\n", encoding="utf-8")
+
+    sections = _map_sections(rep, out, dpi, files) + _parameter_sections(rep, out, dpi, files)
+
+    head = _header(study, ref_label, swept)
+    files["report_md"].write_text(_markdown(head, sections), encoding="utf-8")
+    files["report_html"].write_text(_html(study, head, sections, out, embed_images),
+                                    encoding="utf-8")
+    return files
+
+
+def _map_sections(rep: StudyReport, out: Path, dpi: int,
+                  files: dict[str, Path]) -> list[_Section]:
+    """A section per map entry (its table and box plots, added to ``files``), then one per
+    kind with several entries, pooled."""
+    study, rl, ref_label = rep.study, rep.r_length, rep.reference_label
+    rows = rep.rows
+    from pathfuse.viz import report as viz
 
     sections: list[_Section] = []
     names = _scope_names(study)
@@ -424,7 +439,17 @@ def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[st
             files[f"r_length_{_slug(scope)}_pooled"] = out / name
             sec.images.append((name, f"R_length against {ref_label}, every entry pooled"))
         sections.append(sec)
+    return sections
 
+
+def _parameter_sections(rep: StudyReport, out: Path, dpi: int,
+                        files: dict[str, Path]) -> list[_Section]:
+    """The swept parameters: a section and a plot per parameter."""
+    study = rep.study
+    prows, swept = rep.parameter_rows, rep.swept
+    from pathfuse.viz import report as viz
+
+    sections: list[_Section] = []
     if prows:
         sections.append(_Section(
             "Swept parameters",
@@ -464,12 +489,7 @@ def _write(rep: StudyReport, out: Path, dpi: int, embed_images: bool) -> dict[st
             sec.images.append((name, f"{p} against success rate (95% Wilson) and mean length "
                                      "(95% t)"))
             sections.append(sec)
-
-    head = _header(study, ref_label, swept)
-    files["report_md"].write_text(_markdown(head, sections), encoding="utf-8")
-    files["report_html"].write_text(_html(study, head, sections, out, embed_images),
-                                    encoding="utf-8")
-    return files
+    return sections
 
 
 def _header(study: Study, ref_label: str, swept: Mapping[tuple[str, str], Sequence[str]]

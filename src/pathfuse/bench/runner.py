@@ -439,7 +439,7 @@ def _connect_check(scheduler: Any) -> None:
     """Fail early (before touching the database) on a bad scheduler value."""
     if isinstance(scheduler, str):
         if "://" not in scheduler:
-            raise ConfigError(f"scheduler: expected an address like tcp://HOST:8786, "
+            raise ConfigError(f"scheduler: must be an address like tcp://HOST:8786, "
                               f"got {scheduler!r}")
         try:
             import distributed  # type: ignore[import-not-found]  # noqa: F401

@@ -359,7 +359,7 @@ def _check_lines_form(sel: Any, where: str) -> None:
         if ok:
             _select_lines([], sel, where)  # checks the numbers
     if not ok:
-        raise ConfigError(f"{where}: expected N, a list of line numbers, {{limit: N}}, "
+        raise ConfigError(f"{where}: must be N, a list of line numbers, {{limit: N}}, "
                           f"{{sample: N, seed: S}} or {{every: K}}, got {_short(sel)}")
 
 
@@ -411,7 +411,7 @@ def _select_lines(probs: list[Any], sel: Any, where: str) -> list[Any]:
             if not _is_int(k) or k < 1:
                 raise ConfigError(f"{where}.every: must be an integer >= 1, got {_shown(k)}")
             return probs[:: int(k)]
-    raise ConfigError(f"{where}: expected N, a list of line numbers, {{limit: N}}, "
+    raise ConfigError(f"{where}: must be N, a list of line numbers, {{limit: N}}, "
                       f"{{sample: N, seed: S}} or {{every: K}}, got {_short(sel)}")
 
 

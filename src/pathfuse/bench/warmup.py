@@ -24,11 +24,11 @@ def _metric_kernels() -> list:
 
 
 def _world_kernels() -> list:
-    from pathfuse import shield
-    from pathfuse.world import geometry, obstacles
+    from pathfuse import shield, sweep
+    from pathfuse.world import obstacles
 
-    return [obstacles._clear, obstacles._bounce_trajectory, geometry.disc_sweep_gaps,
-            geometry.segment_static_distance, shield.shield_unicycle,
+    return [obstacles._clear, obstacles._bounce_trajectory, sweep.disc_sweep_gaps,
+            sweep.segment_static_distance, shield.shield_unicycle,
             shield.shield_holonomic]
 
 
@@ -71,11 +71,13 @@ def warm_kernels(planners: Iterable[str], metrics: bool = True, world: bool = Fa
 
         warmup()
     if world:
+        from pathfuse.geometry import point_segment_distance
         from pathfuse.shield import warmup_shield
-        from pathfuse.world.geometry import warmup_geometry
+        from pathfuse.sweep import warmup_segments
         from pathfuse.world.obstacles import warmup_obstacles
 
-        warmup_geometry()
+        warmup_segments()
+        point_segment_distance(1.0, 1.0, 0.0, 0.0, 2.0, 0.0)  # World's goal test
         warmup_obstacles()
         warmup_shield()
     return cold

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from pathfuse.result import ConfigError, PathfuseError
+from pathfuse.validate import point
 from pathfuse.validate import short as _shown
 
 EXIT_FAIL = 1
@@ -51,16 +52,9 @@ and experiment files every installation has, which commands also take by name.  
 def parse_point(text: str, what: str) -> tuple[float, float]:
     """``"1.5,2"`` -> (1.5, 2.0); :class:`CliError` naming ``what`` otherwise."""
     parts = [p.strip() for p in str(text).replace(";", ",").split(",")]
-    try:
-        if len(parts) != 2:
-            raise ValueError
-        x, y = float(parts[0]), float(parts[1])
-    except ValueError:
-        raise CliError(f"{what}: expected X,Y (two numbers in metres), got"
-                       f" {_shown(text)}") from None
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise CliError(f"{what}: coordinates must be finite, got {_shown(text)}")
-    return x, y
+    if len(parts) != 2:
+        raise CliError(f"{what}: must be X,Y (two numbers in metres), got {_shown(text)}")
+    return point(parts, what, CliError)
 
 
 def parse_params(items: Sequence[str] | None) -> dict[str, Any]:
@@ -71,7 +65,7 @@ def parse_params(items: Sequence[str] | None) -> dict[str, Any]:
     for item in items or []:
         key, sep, val = item.partition("=")
         if not sep or not key.strip():
-            raise CliError(f"--param: expected KEY=VALUE, got {_shown(item)}")
+            raise CliError(f"--param: must be KEY=VALUE, got {_shown(item)}")
         try:
             out[key.strip()] = load_yaml(val, f"--param {key.strip()}", CliError)
         except CliError:
@@ -90,7 +84,7 @@ def _int_at_least(minimum: int, what: str):
         except ValueError:
             v = minimum - 1
         if v < minimum:
-            raise argparse.ArgumentTypeError(f"expected {what}, got {_shown(text)}")
+            raise argparse.ArgumentTypeError(f"must be {what}, got {_shown(text)}")
         return v
 
     return parse
@@ -104,23 +98,23 @@ def _float(text: str) -> float:
     try:
         v = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {_shown(text)}") from None
+        raise argparse.ArgumentTypeError(f"must be a number, got {_shown(text)}") from None
     if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {_shown(text)}")
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {_shown(text)}")
     return v
 
 
 def _nonneg_float(text: str) -> float:
     v = _float(text)
     if v < 0:
-        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {_shown(text)}")
+        raise argparse.ArgumentTypeError(f"must be a number >= 0, got {_shown(text)}")
     return v
 
 
 def _positive_float(text: str) -> float:
     v = _float(text)
     if v <= 0:
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {_shown(text)}")
+        raise argparse.ArgumentTypeError(f"must be a number > 0, got {_shown(text)}")
     return v
 
 
@@ -138,7 +132,7 @@ def parse_speed(text: str) -> tuple[float, float]:
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
             raise ValueError
     except ValueError:
-        raise CliError(f"--speed: expected MIN,MAX in m/s with 0 < MIN <= MAX, "
+        raise CliError(f"--speed: must be MIN,MAX in m/s with 0 < MIN <= MAX, "
                        f"got {_shown(text)}") from None
     return lo, hi
 
@@ -149,7 +143,7 @@ def parse_planner_list(text: str | None) -> tuple[str, ...]:
         return ()
     names = tuple(n.strip() for n in str(text).split(",") if n.strip())
     if not names:
-        raise CliError(f"--planners: expected comma-separated online planner names, "
+        raise CliError(f"--planners: must be comma-separated online planner names, "
                        f"got {_shown(text)}")
     return names
 
@@ -160,7 +154,7 @@ def parse_planner_params(items: Sequence[str] | None) -> dict[str, dict[str, Any
     for key, val in parse_params(items).items():
         name, dot, param = key.partition(".")
         if not dot or not name or not param:
-            raise CliError(f"--param: expected PLANNER.KEY=VALUE, got {_shown(key)}")
+            raise CliError(f"--param: must be PLANNER.KEY=VALUE, got {_shown(key)}")
         out.setdefault(name, {})[param] = val
     return out
 

@@ -65,7 +65,15 @@ from pathfuse.field.repulsion import (
     static_repulsion,
 )
 from pathfuse.geometry import segment_is_clear
-from pathfuse.result import Status
+from pathfuse.result import (
+    CODE_COLLISION,
+    CODE_LOCAL_MINIMUM,
+    CODE_RUNNING,
+    CODE_SUCCESS,
+    Status,
+    code_outcome,
+    refined,
+)
 
 __all__ = [
     "CODE_RUNNING",
@@ -81,12 +89,11 @@ __all__ = [
     "pack_fusion",
 ]
 
-CODE_RUNNING = 0
-CODE_GOAL = 1
-CODE_STALLED = 2
-CODE_BLOCKED = 3
-CODE_GOAL_SNAP = 4
-CODE_COLLISION = 5
+# The loops' codes, from :class:`~pathfuse.result.Status` (:data:`~pathfuse.result.CODE_SUCCESS`).
+CODE_GOAL = CODE_SUCCESS
+CODE_GOAL_SNAP = refined(CODE_SUCCESS)
+CODE_STALLED = CODE_LOCAL_MINIMUM
+CODE_BLOCKED = refined(CODE_LOCAL_MINIMUM)
 
 # --- float settings shared by both loops (slots 0..19)
 F_GX, F_GY, F_KATT, F_KREP, F_RHO0, F_STEP, F_TOL, F_CLEAR, F_STALLD, F_OX = range(10)
@@ -119,12 +126,9 @@ N_S = 10
 
 def code_status(code: int, steps: int, max_steps: int) -> Status:
     """The :class:`~pathfuse.result.Status` of a finished loop."""
-    if code == CODE_GOAL or code == CODE_GOAL_SNAP:
-        return Status.SUCCESS
-    if code == CODE_STALLED or code == CODE_BLOCKED:
-        return Status.LOCAL_MINIMUM
-    if code == CODE_COLLISION:
-        return Status.COLLISION
+    status = code_outcome(code)
+    if status is not None:
+        return status
     if steps >= max_steps:
         return Status.MAX_ITERATIONS
     return Status.TIMEOUT
@@ -363,6 +367,11 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
     return nx, ny, True, math.hypot(tx - nx, ty - ny) <= 0.5 * step
 
 
+# Long on purpose (~190 lines): Algorithm 2 and pathfuse's escape are one state machine
+# (the modes of ``state[S_MODE]``) whose transitions share a dozen locals (position,
+# progress index, stall reference, escape targets); simulate() enters it once per tick,
+# so split into calls every piece would pass that state in and out.  The force and the
+# step already are helpers (fusion_force, _step, _escape_move, _goal_reached).
 @njit(cache=True)
 def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel, drad):
     """Algorithm 2 steps from ``buf[n-1]`` along the global path ``pts`` (M, 2).

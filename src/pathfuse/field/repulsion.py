@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 from pathfuse.field.forces import D_MIN_M, att_force_xy, rep_force_xy, rep_potential_d
@@ -407,8 +406,3 @@ def disc_repulsion(x, y, vx, vy, radius, pos, vel, radii, k_rep, rho0_m, reach_m
         fx += rx
         fy += ry
     return fx, fy
-
-
-def no_discs() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Empty disc arrays (positions, velocities, radii) for a static map."""
-    return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0)

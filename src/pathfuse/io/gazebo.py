@@ -133,7 +133,7 @@ def _bool(doc: SdfDoc, el: ET.Element | None, default: bool) -> bool:
         return True
     if t in ("0", "false"):
         return False
-    raise doc.fail(el, f"<{el.tag}>: expected true/false/1/0, got {t!r}")
+    raise doc.fail(el, f"<{el.tag}>: must be true/false/1/0, got {t!r}")
 
 
 def _name(doc: SdfDoc, el: ET.Element, kind: str) -> str:

@@ -110,7 +110,7 @@ def _header_int(path: Path, lineno: int, key: str, text: bytes) -> int:
     parts = text.split()
     if len(parts) != 2 or parts[0].decode("ascii", "replace").lower() != key:
         raise MapFormatError(
-            f"{path}, line {lineno}: expected '{key} <integer>', "
+            f"{path}, line {lineno}: must be '{key} <integer>', "
             f"got {_shown(text.decode('ascii', 'replace'))}"
         )
     raw = parts[1].decode("ascii", "replace")
@@ -170,7 +170,7 @@ def read_movingai(
         if first[:1] == [b"version"] or path.suffix.lower() == ".scen":
             hint = " (this is a MovingAI scenario file (.scen), not a map: give the .map first)"
         raise MapFormatError(
-            f"{path}, line {i + 1}: expected header 'type octile', "
+            f"{path}, line {i + 1}: must be the header 'type octile', "
             f"got {_shown(lines[i].decode('ascii', 'replace'))}{hint}"
         )
     if first[1].lower() != b"octile":
@@ -190,7 +190,7 @@ def read_movingai(
         if key_s not in ("height", "width") or key_s in sizes:
             want = " or ".join(k for k in ("height", "width") if k not in sizes)
             raise MapFormatError(
-                f"{path}, line {i + 1}: expected '{want} <integer>', "
+                f"{path}, line {i + 1}: must be '{want} <integer>', "
                 f"got {_shown(lines[i].decode('ascii', 'replace'))}"
             )
         sizes[key_s] = _header_int(path, i + 1, key_s, lines[i])
@@ -199,7 +199,7 @@ def read_movingai(
         raise MapFormatError(f"{path}, line {i + 1}: file ends inside the header (expected 'map')")
     if lines[i].strip().lower() != b"map":
         got = lines[i].decode("ascii", "replace")
-        raise MapFormatError(f"{path}, line {i + 1}: expected 'map', got {_shown(got)}")
+        raise MapFormatError(f"{path}, line {i + 1}: must be 'map', got {_shown(got)}")
     height, width = sizes["height"], sizes["width"]
     check_cells(height, width, f"{path}: header")
     first_row = i + 1

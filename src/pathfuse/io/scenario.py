@@ -104,7 +104,7 @@ def _check_version(path: Path, lines: list[str]) -> None:
         if parts[:1] == ["type"] or path.suffix.lower() == ".map":
             hint = " (this is a MovingAI map (.map), not a scenario file: give the .map first)"
         raise MapFormatError(
-            f"{path}, line 1: expected 'version 1' or 'version 1.0', "
+            f"{path}, line 1: must be 'version 1' or 'version 1.0', "
             f"got {_shown(lines[0][:60])}{hint}"
         )
 
@@ -163,7 +163,7 @@ def read_scen(path: str | os.PathLike[str], grid: GridMap) -> list[ScenProblem]:
         cols = _split(line)
         if len(cols) != 9:
             raise MapFormatError(
-                f"{path}, line {lineno}: expected 9 columns "
+                f"{path}, line {lineno}: must have 9 columns "
                 f"(bucket map W H sx sy gx gy optimal), got {len(cols)}"
             )
         names = ("bucket", "map", "map width", "map height", "start x", "start y",

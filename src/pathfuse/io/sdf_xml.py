@@ -142,11 +142,11 @@ def floats(doc: SdfDoc, el: ET.Element, what: str, n: int | tuple[int, ...]) -> 
     try:
         vals = [float(t) for t in text]
     except ValueError:
-        raise doc.fail(el, f"<{el.tag}> of {what}: expected numbers, got "
+        raise doc.fail(el, f"<{el.tag}> of {what}: must be numbers, got "
                            f"{(el.text or '').strip()!r}") from None
     if len(vals) not in counts or not all(math.isfinite(v) for v in vals):
         want = " or ".join(str(c) for c in counts)
-        raise doc.fail(el, f"<{el.tag}> of {what}: expected {want} finite numbers, got "
+        raise doc.fail(el, f"<{el.tag}> of {what}: must be {want} finite numbers, got "
                            f"{(el.text or '').strip()!r}")
     return vals
 
@@ -178,6 +178,6 @@ def pose_of(doc: SdfDoc, parent: ET.Element, what: str, frames: tuple[str, ...])
             r, p, yw = math.radians(r), math.radians(p), math.radians(yw)
         rot = rpy(r, p, yw)
     else:
-        raise doc.fail(el, f"<pose rotation_format={fmt!r}> of {what}: expected euler_rpy "
+        raise doc.fail(el, f"<pose rotation_format={fmt!r}> of {what}: must be euler_rpy "
                            "or quat_xyzw")
     return rot, np.array([x, y, z])

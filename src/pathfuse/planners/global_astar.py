@@ -225,14 +225,14 @@ def _plan_with_margin(problem: Problem, occ: np.ndarray, sc: tuple[int, int],
     margin = problem.inflation_m
     mult = clearance_multipliers(grid, problem.robot_radius_m, margin)
     t0 = time.perf_counter()
-    code, cells, cost, exp = costaware_search(occ, mult, sc, gc, corner_cutting,
-                                              max_expansions)
+    status, cells, cost, exp = costaware_search(occ, mult, sc, gc, corner_cutting,
+                                                max_expansions)
     elapsed = time.perf_counter() - t0
-    if code == 1:
+    if status is Status.NO_PATH:
         return GlobalPlan(Status.NO_PATH, expansions=exp, time_s=elapsed,
                           message=f"goal is not reachable from start ({exp} expansions)",
                           heuristic=heuristic, corner_cutting=corner_cutting)
-    if code == 2:
+    if status is Status.MAX_ITERATIONS:
         return GlobalPlan(Status.MAX_ITERATIONS, expansions=exp, time_s=elapsed,
                           message=f"stopped after {exp} expansions (max_iterations)",
                           heuristic=heuristic, corner_cutting=corner_cutting)

@@ -78,13 +78,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pathfuse.result import ConfigError, MapError, QueryError, Status
+from pathfuse.result import (
+    CODE_GROW,
+    CODE_NO_PATH,
+    CODE_SUCCESS,
+    ConfigError,
+    MapError,
+    QueryError,
+    Status,
+)
 from pathfuse.search.kernel import (
     _BLOCKED,
     _CHUNK,
-    _EXHAUSTED,
-    _FOUND,
-    _HEAP_FULL,
     _RING_SIZE,
     _STAMP_LIMIT,
     _astar_kernel,
@@ -320,14 +325,14 @@ class AStarSearcher(_Regions):
             )
             first = -1
             done += n
-            if code == _FOUND:
+            if code == CODE_SUCCESS:
                 cells, pts = _trace(self._cell, start, goal, wp, *origin)
                 return SearchResult(Status.SUCCESS, cells, float(self._g[goal]), done, pts)
-            if code == _EXHAUSTED:
+            if code == CODE_NO_PATH:
                 if self._labels is None:  # the next query between regions: no search
                     self._labels = self._make_labels()
                 return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, done)
-            if code == _HEAP_FULL:
+            if code == CODE_GROW:
                 self._grow_heap()
                 continue
             if done >= budget:

@@ -37,6 +37,13 @@ import numpy as np
 from numba import njit
 
 from pathfuse.geometry import point_box_distance
+from pathfuse.result import (
+    CODE_MAX_ITERATIONS,
+    CODE_NO_PATH,
+    CODE_SUCCESS,
+    Status,
+    code_outcome,
+)
 from pathfuse.search.heap import heap_pop, heap_push
 
 __all__ = ["CLEARANCE_COST", "clearance_multipliers", "costaware_search", "warmup_costaware"]
@@ -124,10 +131,10 @@ def _search(occ, mult, sr, sc, gr, gc, corner_cutting, max_exp):
             continue
         closed[u] = True
         if u == goal:
-            return g, parent, 0, exp
+            return g, parent, CODE_SUCCESS, exp
         exp += 1
         if exp > max_exp:
-            return g, parent, 2, exp
+            return g, parent, CODE_MAX_ITERATIONS, exp
         ur = u // w
         uc = u % w
         for dr in range(-1, 2):
@@ -153,23 +160,25 @@ def _search(occ, mult, sr, sc, gr, gc, corner_cutting, max_exp):
                     parent[v] = u
                     keys, nodes, size = heap_push(keys, nodes, size,
                                                   ng + math.hypot(vr - gr, vc - gc), v)
-    return g, parent, 1, exp
+    return g, parent, CODE_NO_PATH, exp
 
 
 def costaware_search(occ: np.ndarray, mult: np.ndarray, start: tuple[int, int],
                      goal: tuple[int, int], corner_cutting: bool = False,
-                     max_expansions: int | None = None):
+                     max_expansions: int | None = None
+                     ) -> tuple[Status | None, np.ndarray, float, int]:
     """Cost-aware A* between two free cells of ``occ`` (see the module docstring).
 
-    Returns ``(status, cells, cost_cells, expansions)``: status 0 found, 1 no
-    path, 2 expansion cap; ``cells`` (N, 2) ``(row, col)`` from start to goal;
-    ``cost_cells`` the path's cost in cell sides.
+    Returns ``(status, cells, cost_cells, expansions)``: status ``SUCCESS``,
+    ``NO_PATH`` or ``MAX_ITERATIONS`` (the expansion cap); ``cells`` (N, 2)
+    ``(row, col)`` from start to goal; ``cost_cells`` the path's cost in cell sides.
     """
     cap = int(max_expansions) if max_expansions is not None else occ.size + 1
     g, parent, code, exp = _search(occ, mult, start[0], start[1], goal[0], goal[1],
                                    bool(corner_cutting), cap)
-    if code != 0:
-        return code, np.zeros((0, 2), dtype=np.int64), math.inf, exp
+    status = code_outcome(code)
+    if status is not Status.SUCCESS:
+        return status, np.zeros((0, 2), dtype=np.int64), math.inf, exp
     w = occ.shape[1]
     u = goal[0] * w + goal[1]
     out = []
@@ -177,7 +186,7 @@ def costaware_search(occ: np.ndarray, mult: np.ndarray, start: tuple[int, int],
         out.append((u // w, u % w))
         u = int(parent[u])
     cells = np.array(out[::-1], dtype=np.int64)
-    return 0, cells, float(g[goal[0] * w + goal[1]]), exp
+    return status, cells, float(g[goal[0] * w + goal[1]]), exp
 
 
 def warmup_costaware() -> None:

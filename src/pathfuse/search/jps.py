@@ -55,16 +55,20 @@ import weakref
 import numpy as np
 from numba import njit
 
-from pathfuse.result import MapError, QueryError, Status
+from pathfuse.result import (
+    CODE_NO_PATH,
+    CODE_RUNNING,
+    CODE_SUCCESS,
+    MapError,
+    QueryError,
+    Status,
+)
 from pathfuse.search.astar import _EAGER_LABELS, SearchResult, _Regions
 from pathfuse.search.heap import heap_pop, heap_push
 from pathfuse.search.kernel import _bit_length, _trailing_zeros
 
 __all__ = ["JPSSearcher", "get_jps_searcher", "warmup"]
 
-_FOUND = 0
-_EXHAUSTED = 1
-_CHUNK_DONE = 2
 _CHUNK = 1 << 14  # expansions between clock checks when a time limit is set
 _STAMP_LIMIT = np.iinfo(np.int32).max - 4
 _SQRT2 = 1.4142135623730951
@@ -198,10 +202,10 @@ def _jps_kernel(free, rows, cols, nwr, nwc, gbuf, stamp, parent, hkey, hnode, me
     else:
         size = meta[0]
     n_exp = 0
-    code = _EXHAUSTED
+    code = CODE_NO_PATH
     while size > 0:
         if n_exp >= max_exp:
-            code = _CHUNK_DONE
+            code = CODE_RUNNING
             break
         p, size = heap_pop(hkey, hnode, size)
         if stamp[p] == closed:
@@ -209,7 +213,7 @@ def _jps_kernel(free, rows, cols, nwr, nwc, gbuf, stamp, parent, hkey, hnode, me
         stamp[p] = closed
         n_exp += 1
         if p == goal:
-            code = _FOUND
+            code = CODE_SUCCESS
             break
         g0 = gbuf[p]
         # the direction p was reached in (none at the start: all eight)
@@ -451,10 +455,10 @@ class JPSSearcher(_Regions):
                 first, goal, wp, min(chunk, budget - done))
             first = -1
             done += n
-            if code == _FOUND:
+            if code == CODE_SUCCESS:
                 cells, pts, a, b = _jps_trace(self._parent, start, goal, wp, ox, oy, res)
                 return SearchResult(Status.SUCCESS, cells, a + b * _SQRT2, done, pts)
-            if code == _EXHAUSTED:
+            if code == CODE_NO_PATH:
                 if self._labels is None:
                     self._labels = self._make_labels()
                 return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, done)

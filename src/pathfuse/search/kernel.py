@@ -11,11 +11,7 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-# kernel return codes
-_FOUND = 0
-_EXHAUSTED = 1
-_CHUNK_DONE = 2
-_HEAP_FULL = 3
+from pathfuse.result import CODE_GROW, CODE_NO_PATH, CODE_RUNNING, CODE_SUCCESS
 
 _CHUNK = 1 << 16  # expansions between clock checks when a time limit is set
 _RING_SCALE = 1024.0  # ring buckets per cell of f (euclidean open list)
@@ -134,6 +130,10 @@ def _spop(skey, snode, size):
     return top, size
 
 
+# Long on purpose (~200 lines): the hot loop of every grid search, one function so
+# that numba keeps its state (the open list's heads, the current cell's word and its
+# neighbours') in locals; the pieces that stand alone are already helpers, and
+# tests/test_astar_golden.py pins its paths and expansion counts.
 @njit(cache=True, nogil=True)
 def _astar_kernel(
     cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, gen,
@@ -228,13 +228,13 @@ def _astar_kernel(
     cap = qkey.shape[0]
     scap = skey.shape[0]
     n_exp = 0
-    code = _EXHAUSTED
+    code = CODE_NO_PATH
     while size > 0 or ssize > 0:
         if n_exp >= max_exp:
-            code = _CHUNK_DONE
+            code = CODE_RUNNING
             break
         if used + 8 > cap or size + ssize + 8 > scap:
-            code = _HEAP_FULL
+            code = CODE_GROW
             break
         # ---- pop the entry with the smallest f
         if use_ring:
@@ -293,7 +293,7 @@ def _astar_kernel(
         cell[p] = closedv | (sp & low)
         n_exp += 1
         if p == ugoal:
-            code = _FOUND
+            code = CODE_SUCCESS
             break
         # ---- relax the 8 moves
         g0 = gbuf[p]

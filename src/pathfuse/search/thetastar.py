@@ -48,16 +48,13 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from pathfuse.result import Status
+from pathfuse.result import CODE_NO_PATH, CODE_RUNNING, CODE_SUCCESS, Status
 from pathfuse.search.heap import heap_pop as _pop
 from pathfuse.search.heap import heap_push as _push
 from pathfuse.search.los import line_of_sight
 
 __all__ = ["AnyAngleResult", "theta_star", "warmup"]
 
-_FOUND = 0
-_EXHAUSTED = 1
-_CHUNK_DONE = 2
 _CHUNK = 1 << 14  # expansions between clock checks when a time limit is set
 
 _DR = np.array([0, 0, 1, -1, 1, 1, -1, -1], dtype=np.int64)
@@ -152,7 +149,7 @@ def _theta_kernel(free, occ, ox, oy, res, clear, snode, sx, sy, gnode, gx, gy, l
         if u == gnode:
             meta[0] = size
             meta[1] = exp
-            return _FOUND, hkey, hnode
+            return CODE_SUCCESS, hkey, hnode
         closed[u] = True
         exp += 1
         done += 1
@@ -186,10 +183,10 @@ def _theta_kernel(free, occ, ox, oy, res, clear, snode, sx, sy, gnode, gx, gy, l
         if done >= max_exp:
             meta[0] = size
             meta[1] = exp
-            return _CHUNK_DONE, hkey, hnode
+            return CODE_RUNNING, hkey, hnode
     meta[0] = size
     meta[1] = exp
-    return _EXHAUSTED, hkey, hnode
+    return CODE_NO_PATH, hkey, hnode
 
 
 @njit(cache=True)
@@ -267,10 +264,10 @@ def theta_star(free: np.ndarray, occ: np.ndarray, ox: float, oy: float, res: flo
         code, hkey, hnode = _theta_kernel(free_c, occ_c, ox, oy, res, clear, snode, sx, sy,
                                           gnode, gx, gy, lazy, g, parent, closed, hkey, hnode,
                                           meta, step)
-        if code == _FOUND:
+        if code == CODE_SUCCESS:
             pts = _trace(parent, snode, gnode, w, sx, sy, gx, gy, ox, oy, res)
             return AnyAngleResult(Status.SUCCESS, pts, float(g[gnode]), int(meta[1]))
-        if code == _EXHAUSTED:
+        if code == CODE_NO_PATH:
             return AnyAngleResult(Status.NO_PATH, np.zeros((0, 2)), math.inf, int(meta[1]))
         if int(meta[1]) >= budget:
             return AnyAngleResult(Status.MAX_ITERATIONS, np.zeros((0, 2)), math.inf,

@@ -65,7 +65,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.geometry import MARGIN_FRAC, _segment_hits_box
-from pathfuse.result import Status
+from pathfuse.result import CODE_NO_PATH, CODE_RUNNING, CODE_SUCCESS, Status
 from pathfuse.search.heap import heap_pop as _pop
 from pathfuse.search.heap import heap_push as _push
 from pathfuse.search.thetastar import AnyAngleResult
@@ -215,7 +215,7 @@ def _vis_kernel(occ, q, xs, ys, ts, g, parent, closed, hkey, hnode, meta, max_ex
         if u == goal:
             meta[0] = size
             meta[1] = exp
-            return 0, hkey, hnode
+            return CODE_SUCCESS, hkey, hnode
         closed[u] = True
         exp += 1
         done += 1
@@ -248,10 +248,10 @@ def _vis_kernel(occ, q, xs, ys, ts, g, parent, closed, hkey, hnode, meta, max_ex
         if done >= max_exp:
             meta[0] = size
             meta[1] = exp
-            return 2, hkey, hnode
+            return CODE_RUNNING, hkey, hnode
     meta[0] = size
     meta[1] = exp
-    return 1, hkey, hnode
+    return CODE_NO_PATH, hkey, hnode
 
 
 _CORNERS: dict[tuple[tuple[int, ...], bytes, float],
@@ -357,7 +357,7 @@ def _search(occ: np.ndarray, q: float, cx: np.ndarray, cy: np.ndarray, ct: np.nd
                                   int(meta[1]))
         code, hkey, hnode = _vis_kernel(occ, q, xs, ys, ts, g, parent, closed, hkey, hnode,
                                         meta, step)
-        if code == 0 and parent[n - 1] >= 0:
+        if code == CODE_SUCCESS and parent[n - 1] >= 0:
             chain = [n - 1]
             while chain[-1] != n - 2:
                 chain.append(int(parent[chain[-1]]))
@@ -366,7 +366,7 @@ def _search(occ: np.ndarray, q: float, cx: np.ndarray, cy: np.ndarray, ct: np.nd
             pts[0] = start
             pts[-1] = goal
             return AnyAngleResult(Status.SUCCESS, pts, float(g[n - 1]) * res, int(meta[1]))
-        if code != 2:
+        if code != CODE_RUNNING:
             return AnyAngleResult(Status.NO_PATH, np.zeros((0, 2)), math.inf, int(meta[1]))
         if int(meta[1]) >= budget:
             return AnyAngleResult(Status.MAX_ITERATIONS, np.zeros((0, 2)), math.inf,

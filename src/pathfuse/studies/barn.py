@@ -54,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-from pathfuse.result import ConfigError
+from pathfuse.result import ConfigError, Status
 
 __all__ = [
     "BARN_START", "BARN_START_YAW", "BARN_GOAL", "BARN_GOAL_TOLERANCE_M", "BARN_TIME_LIMIT_S",
@@ -140,13 +140,13 @@ def parse_world_selection(text: str | Sequence[int] | None
         for a, b in text:
             if not all(isinstance(v, int) and not isinstance(v, bool) for v in (a, b)) \
                     or not 0 <= a <= b:
-                raise ConfigError(f"worlds: expected ranges (first, last), got {text!r}")
+                raise ConfigError(f"worlds: must be ranges (first, last), got {text!r}")
         return tuple(sorted(set(text)))
     if not isinstance(text, str):
         vals = list(text)
         if not vals or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool)
                                and v >= 0 for v in vals):
-            raise ConfigError(f"worlds: expected indices >= 0, got {text!r}")
+            raise ConfigError(f"worlds: must be indices >= 0, got {text!r}")
         out = [(int(v), int(v)) for v in vals]
     else:
         for part in text.split(","):
@@ -160,7 +160,7 @@ def parse_world_selection(text: str | Sequence[int] | None
             elif part.isdigit():
                 out.append((int(part), int(part)))
             else:
-                raise ConfigError(f"worlds: expected indices and ranges such as 0-9,17, got "
+                raise ConfigError(f"worlds: must be indices and ranges such as 0-9,17, got "
                                   f"{text!r}")
     return tuple(sorted(set(out)))
 
@@ -181,7 +181,7 @@ class BarnWorld:
                 from None
         if ij.ndim != 2 or ij.shape[1] != 2 or ij.shape[0] < 1 or \
                 not np.issubdtype(ij.dtype, np.number):
-            raise ConfigError(f"{self.path_file}: expected an (M, 2) array of grid points, got "
+            raise ConfigError(f"{self.path_file}: must be an (M, 2) array of grid points, got "
                               f"shape {ij.shape} of {ij.dtype}")
         return reference_length(ij)
 
@@ -313,7 +313,7 @@ class BarnConfig:
                     or v <= 0:
                 raise ConfigError(f"{key}: must be a number > 0, got {v!r}")
         if isinstance(self.planners, str):
-            raise ConfigError(f"planners: expected a list of names, got {self.planners!r}")
+            raise ConfigError(f"planners: must be a list of names, got {self.planners!r}")
         names = []
         for n in tuple(self.planners) or tuple(p for p in planner_names() if REGISTRY[p].online):
             try:
@@ -325,7 +325,7 @@ class BarnConfig:
             names.append(spec.name)
         object.__setattr__(self, "planners", tuple(dict.fromkeys(names)))
         if not isinstance(self.params, Mapping):
-            raise ConfigError(f"params: expected {{planner: {{key: value}}}}, got "
+            raise ConfigError(f"params: must be {{planner: {{key: value}}}}, got "
                               f"{self.params!r}")
         for n, p in self.params.items():
             if n not in self.planners:
@@ -333,7 +333,7 @@ class BarnConfig:
                                   f"({', '.join(self.planners)})")
             make_params(get_planner(n), p, key=f"params.{n}")
         if not isinstance(self.robot, Mapping):
-            raise ConfigError(f"robot: expected a mapping (radius, max_speed, ...), got "
+            raise ConfigError(f"robot: must be a mapping (radius, max_speed, ...), got "
                               f"{self.robot!r}")
         object.__setattr__(self, "robot", dict(self.robot))
 
@@ -385,7 +385,7 @@ def load_barn_file(path: str | os.PathLike[str]) -> tuple[BarnConfig, dict[str, 
             kw[key] = doc[key]
     if doc.get("planners") is not None:
         if not isinstance(doc["planners"], list):
-            raise ConfigError(f"{p}: planners: expected a list of names, got "
+            raise ConfigError(f"{p}: planners: must be a list of names, got "
                               f"{doc['planners']!r}")
         kw["planners"] = tuple(doc["planners"])
     try:
@@ -486,9 +486,12 @@ def episode_record(world: BarnWorld, planner: str, row: Mapping[str, Any], dt: f
     moved = np.hypot(pos[:, 0] - BARN_START[0], pos[:, 1] - BARN_START[1]) >= BARN_MOVE_START_M
     t_start = float(times[int(np.argmax(moved))]) if moved.any() else 0.0
     end = float(times[-1])
-    success = status == "SUCCESS"
-    outcome = "success" if success else "collision" if status == "COLLISION" else "timeout"
-    time_s = end - t_start if success else (end - t_start if outcome == "collision"
+    success = status == Status.SUCCESS.name
+    # the challenge's three outcomes (barn_report.OUTCOMES): any other end is a timeout
+    ended = Status.SUCCESS if success else Status.COLLISION \
+        if status == Status.COLLISION.name else Status.TIMEOUT
+    outcome = ended.value
+    time_s = end - t_start if success else (end - t_start if ended is Status.COLLISION
                                             else BARN_TIME_LIMIT_S)
     rec: dict[str, Any] = {
         "world": int(world.index),

@@ -35,13 +35,16 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse.result import Status
 from pathfuse.stats import markdown_table, mean_ci, wilson_ci, write_csv
 
 __all__ = ["summary_rows", "markdown_report", "text_table", "write_barn_outputs",
            "OUTCOMES", "PERCENTILES", "fault_stats", "percentile_stats", "shield_stats",
            "fault_cell", "percentile_cell", "shield_cell", "social_stats", "SOCIAL_GAP_M"]
 
-OUTCOMES = ("success", "collision", "timeout")
+#: The challenge's outcomes, as stored in an episode's ``status``: the lowercase values
+#: of :class:`~pathfuse.result.Status`.
+OUTCOMES = tuple(s.value for s in (Status.SUCCESS, Status.COLLISION, Status.TIMEOUT))
 PERCENTILES = (5, 50)
 """The percentiles of the minimum clearances reported (over successful episodes)."""
 

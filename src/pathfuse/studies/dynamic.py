@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.bench.summary import group_stats, value_stats
-from pathfuse.result import ConfigError
+from pathfuse.result import ConfigError, Status
 from pathfuse.stats import markdown_table, write_csv
 from pathfuse.studies.barn_report import (
     SOCIAL_GAP_M,
@@ -72,12 +72,11 @@ __all__ = [
     "write_dynamic_outputs",
 ]
 
-#: Episode statuses in table order (``EpisodeStatus`` names).
-OUTCOMES = ("SUCCESS", "COLLISION", "TIMEOUT", "LOCAL_MINIMUM", "NO_PATH")
-_OUTCOME_KEYS = {"SUCCESS": "reached", "COLLISION": "collision", "TIMEOUT": "timeout",
-                 "LOCAL_MINIMUM": "local_minimum", "NO_PATH": "no_path"}
-_OUTCOME_LABELS = {"SUCCESS": "success", "COLLISION": "collision", "TIMEOUT": "timeout",
-                   "LOCAL_MINIMUM": "local min", "NO_PATH": "no path"}
+_ORDER = (Status.SUCCESS, Status.COLLISION, Status.TIMEOUT, Status.LOCAL_MINIMUM,
+          Status.NO_PATH)
+#: Episode statuses in table order (:class:`~pathfuse.result.Status` names); a summary
+#: row counts each under its :attr:`~pathfuse.result.Status.key` ("reached", ...).
+OUTCOMES = tuple(s.name for s in _ORDER)
 
 
 def _is_int(v: Any) -> bool:
@@ -114,7 +113,7 @@ class DynamicConfig:
     >>> DynamicConfig(speed_range=(0.8, 0.3))  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    pathfuse.result.ConfigError: speed_range: expected (low, high) with 0 < low <= high ...
+    pathfuse.result.ConfigError: speed_range: must be (low, high) with 0 < low <= high ...
     """
 
     n_seeds: int = 50
@@ -138,16 +137,16 @@ class DynamicConfig:
             return make_params(spec, params, key=key)
 
         if not _is_int(self.n_seeds) or self.n_seeds < 1:
-            raise ConfigError(f"n_seeds: expected a positive integer, got {_shown(self.n_seeds)}")
+            raise ConfigError(f"n_seeds: must be a positive integer, got {_shown(self.n_seeds)}")
         if not _is_int(self.seed) or self.seed < 0:
-            raise ConfigError(f"seed: expected an integer >= 0, got {_shown(self.seed)}")
+            raise ConfigError(f"seed: must be an integer >= 0, got {_shown(self.seed)}")
         try:
             moving = tuple(self.moving)
         except TypeError:
-            raise ConfigError(f"moving: expected a list of integers >= 0, "
+            raise ConfigError(f"moving: must be a list of integers >= 0, "
                               f"got {_shown(self.moving)}") from None
         if not moving or not all(_is_int(k) and k >= 0 for k in moving):
-            raise ConfigError(f"moving: expected a list of integers >= 0, got"
+            raise ConfigError(f"moving: must be a list of integers >= 0, got"
                               f" {_shown(self.moving)}")
         object.__setattr__(self, "moving", tuple(dict.fromkeys(int(k) for k in moving)))
         import inspect
@@ -163,11 +162,11 @@ class DynamicConfig:
         except (TypeError, ValueError):
             ok = False
         if not ok:
-            raise ConfigError(f"speed_range: expected (low, high) with 0 < low <= high m/s, "
+            raise ConfigError(f"speed_range: must be (low, high) with 0 < low <= high m/s, "
                               f"got {_shown(self.speed_range)}")
         object.__setattr__(self, "speed_range", (lo, hi))
         if isinstance(self.planners, str):
-            raise ConfigError(f"planners: expected a list of names, got {_shown(self.planners)}")
+            raise ConfigError(f"planners: must be a list of names, got {_shown(self.planners)}")
         canonical = []
         for n in tuple(self.planners) or tuple(online_planner_names()):
             try:
@@ -177,17 +176,17 @@ class DynamicConfig:
         names = tuple(dict.fromkeys(canonical))
         object.__setattr__(self, "planners", names)
         if not isinstance(self.params, Mapping):
-            raise ConfigError(f"params: expected {{planner: {{key: value}}}}, "
+            raise ConfigError(f"params: must be {{planner: {{key: value}}}}, "
                               f"got {_shown(self.params)}")
         for n, p in self.params.items():
             if n not in names:
                 raise ConfigError(f"params.{n}: not among the planners run "
                                   f"({', '.join(names)})")
             if not isinstance(p, Mapping):
-                raise ConfigError(f"params.{n}: expected a mapping of parameters, got {_shown(p)}")
+                raise ConfigError(f"params.{n}: must be a mapping of parameters, got {_shown(p)}")
             make_online_params(get_online_planner(n), p, key=f"params.{n}")
         if not isinstance(self.robot, Mapping):
-            raise ConfigError(f"robot: expected a robot block {{key: value}}, got {self.robot!r}")
+            raise ConfigError(f"robot: must be a robot block {{key: value}}, got {self.robot!r}")
         from pathfuse.world.robot import parse_robot
 
         parse_robot(dict(self.robot))
@@ -367,10 +366,10 @@ def summary_rows(run: DynamicRun) -> list[dict[str, Any]]:
                               "solution_length": None, "time": None, "time_to_goal": None}
                              for r in recs], statuses=OUTCOMES)
             row: dict[str, Any] = {"moving": k, "planner": name, "episodes": g["runs"]}
-            for st in OUTCOMES:
-                row[_OUTCOME_KEYS[st]] = g[st.lower()]
-            for st in OUTCOMES:
-                key, low = _OUTCOME_KEYS[st], st.lower()
+            for st in _ORDER:
+                row[st.key] = g[st.value]
+            for st in _ORDER:
+                key, low = st.key, st.value
                 row.update({f"{key}_rate": g[f"{low}_rate"], f"{key}_ci_low": g[f"{low}_ci_low"],
                             f"{key}_ci_high": g[f"{low}_ci_high"]})
             ok = [r for r in recs if r["status"] == "SUCCESS"]
@@ -477,17 +476,15 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
     rows = summary_rows(run) if rows is None else rows
     cfg = run.config
     lo, hi = cfg.speed_range
-    head = ["discs", "planner", "success [95% CI]", "collision", "timeout", "local min",
-            "no path", "path length (m) mean [95% CI]", "median", "time to goal (s) mean "
-            "[95% CI]", "median", "plan time/tick (µs)", "collisions: robot at fault / "
-            "hit standing", "min static clearance (m) p5 / p50", "min disc gap (m) p5 / p50",
-            "shield: commands replaced"]
+    head = ["discs", "planner", f"{_ORDER[0].label} [95% CI]",
+            *(s.label for s in _ORDER[1:]), "path length (m) mean [95% CI]", "median",
+            "time to goal (s) mean [95% CI]", "median", "plan time/tick (µs)",
+            "collisions: robot at fault / hit standing", "min static clearance (m) p5 / p50",
+            "min disc gap (m) p5 / p50", "shield: commands replaced"]
     table = [head]
     for r in rows:
         table.append([
-            str(r["moving"]), r["planner"], _rate_cell(r, "reached"),
-            _rate_cell(r, "collision"), _rate_cell(r, "timeout"),
-            _rate_cell(r, "local_minimum"), _rate_cell(r, "no_path"),
+            str(r["moving"]), r["planner"], *(_rate_cell(r, s.key) for s in _ORDER),
             _stat_cell(r, "path_length", "m"), _median_cell(r, "path_length", "m"),
             _stat_cell(r, "time_to_goal", "s"), _median_cell(r, "time_to_goal", "s"),
             "n/a" if not np.isfinite(r["mean_plan_time_us"]) else f"{r['mean_plan_time_us']:.0f}",

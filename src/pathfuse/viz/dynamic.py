@@ -20,7 +20,6 @@ __all__ = ["ONLINE_COLOURS", "planner_colours", "plot_success_vs_moving"]
 ONLINE_COLOURS = {
     "fusion": "#d62728",
     "apf": "#ff7f0e",
-    "astar-follow": "#1f77b4",
     "astar": "#1f77b4",
     "astar-replan": "#17becf",
     "ref6": "#2ca02c",

@@ -5,7 +5,7 @@
 * :mod:`pathfuse.world.obstacles` - moving discs (constant velocity with
   bounces, patrols, seeded random walks).
 * :mod:`pathfuse.world.world` - :class:`World` (``reset`` / ``step``) with exact
-  continuous collision checks (:mod:`pathfuse.world.geometry`).
+  continuous collision checks (:mod:`pathfuse.sweep`).
 * :mod:`pathfuse.world.episode` - :func:`simulate` and :class:`Episode`: any
   registered planner, driven tick by tick.
 

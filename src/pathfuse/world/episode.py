@@ -248,6 +248,59 @@ def _stalled(positions: np.ndarray, n: int, window: int, radius: float) -> bool:
     return bool(d.max() < radius)
 
 
+def _params_of(spec: Any, params: Any) -> Any:
+    """The planner's parameter dataclass: ``params`` itself when it is one (of the
+    planner's class), else built from a mapping (None: the defaults)."""
+    if dataclasses.is_dataclass(params) and not isinstance(params, type):
+        if type(params) is not spec.params_cls:
+            raise ConfigError(f"params: must be a {spec.params_cls.__name__} for planner "
+                              f"{spec.name!r}, got {type(params).__name__}")
+        return params
+    return make_params(spec, params)
+
+
+def _warm(spec: Any, model: RobotModel) -> None:
+    """Compile (or load) the kernels an episode runs, so that none compiles on a tick."""
+    warm(spec)
+    from pathfuse.shield import warmup_shield
+
+    warmup_shield()  # the world's clip and the shield
+    if model.is_diff_drive:
+        from pathfuse.planners.drive import warmup_drive
+        from pathfuse.sweep import warmup_sweep
+
+        warmup_drive()
+        warmup_sweep()
+
+
+def _first_gaps(world: World, position: np.ndarray) -> tuple[float, float]:
+    """The robot's static clearance and least surface gap to a disc (inf: no discs) at
+    the start."""
+    min_obst = math.inf
+    if world.obstacle_radii.shape[0]:
+        q = world.obstacle_positions[0]
+        g0 = np.hypot(q[:, 0] - position[0], q[:, 1] - position[1]) \
+            - world.obstacle_radii - world.radius
+        min_obst = float(g0.min())
+    return world.static_gap(position), min_obst
+
+
+def _ending(info: Mapping[str, Any], t: float,
+            n: int) -> tuple[Status, str, Any, bool | None]:
+    """``(status, message, collision_with, at_fault)`` of a tick that ended the episode
+    (``info`` from :meth:`World.step`, ``t`` the time after it, ``n`` the positions so far)."""
+    status = Status.from_key(info["event"])
+    if status is Status.SUCCESS:
+        return status, f"reached the goal at t = {t:.2f} s", None, None
+    collision_with = info["collision"]
+    at_fault = info.get("at_fault")
+    what = "the static map" if collision_with == "static" \
+        else f"moving obstacle {collision_with}"
+    message = f"collided with {what} during tick {n - 2} -> {n - 1} (t = {t:.2f} s)"
+    if at_fault is False:
+        message += ": it hit the robot standing still"
+    return status, message, collision_with, at_fault
+
 
 def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
                 seed: int | None = None, robot: Any = None) -> Episode:
@@ -255,13 +308,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
     through ``scenario`` (with ``robot``, a :class:`~pathfuse.robot.RobotModel` or a
     ``robot:`` mapping, instead of the scenario's robot)."""
     spec = get_planner(planner)
-    if dataclasses.is_dataclass(params) and not isinstance(params, type):
-        if type(params) is not spec.params_cls:
-            raise ConfigError(f"params: must be a {spec.params_cls.__name__} for planner "
-                              f"{spec.name!r}, got {type(params).__name__}")
-        cfg = params
-    else:
-        cfg = make_params(spec, params)
+    cfg = _params_of(spec, params)
     scenario = load_scenario(scenario)
     if robot is not None:
         scenario = scenario.replace(robot=_robot_spec(robot))
@@ -283,16 +330,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
 
     problem = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius,
                              clearance_m=model.clearance_m, robot=model)
-    warm(spec)
-    from pathfuse.shield import warmup_shield
-
-    warmup_shield()  # the world's clip and the shield
-    if model.is_diff_drive:
-        from pathfuse.planners.drive import warmup_drive
-        from pathfuse.sweep import warmup_sweep
-
-        warmup_drive()
-        warmup_sweep()
+    _warm(spec, model)
     t0 = time.perf_counter()
     ctrl: Controller = start_online(spec, problem, cfg, float(sc.dt), float(sc.robot.max_speed))
     setup = time.perf_counter() - t0
@@ -301,13 +339,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
     if last_path is not None:
         path_updates.append((0, np.array(last_path)))
 
-    min_static = world.static_gap(obs.position)
-    min_obst = math.inf
-    if k_obs:
-        q = world.obstacle_positions[0]
-        g0 = np.hypot(q[:, 0] - obs.position[0], q[:, 1] - obs.position[1]) \
-            - world.obstacle_radii - world.radius
-        min_obst = float(g0.min())
+    min_static, min_obst = _first_gaps(world, obs.position)
     window = int(round(min(sc.stall_time / sc.dt, sc.n_steps + 1))) if sc.stall_time > 0 else 0
     status = Status.TIMEOUT
     message = ""
@@ -336,19 +368,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
                 path_updates.append((acted, np.array(gp)))
                 last_path = gp
             if terminated:
-                if info["event"] == "reached":
-                    status = Status.SUCCESS
-                    message = f"reached the goal at t = {obs.time:.2f} s"
-                else:
-                    status = Status.COLLISION
-                    collision_with = info["collision"]
-                    at_fault = info.get("at_fault")
-                    what = "the static map" if collision_with == "static" \
-                        else f"moving obstacle {collision_with}"
-                    message = f"collided with {what} during tick {n - 2} -> {n - 1} " \
-                              f"(t = {obs.time:.2f} s)"
-                    if at_fault is False:
-                        message += ": it hit the robot standing still"
+                status, message, collision_with, at_fault = _ending(info, obs.time, n)
                 break
             if truncated:
                 message = f"time limit {sc.time_limit:g} s reached"

@@ -49,8 +49,8 @@ from pathfuse.grid import GridMap
 from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.planners.global_astar import route as global_route
 from pathfuse.result import ConfigError
+from pathfuse.sweep import segment_static_distance
 from pathfuse.validate import short as _shown
-from pathfuse.world.geometry import segment_static_distance
 from pathfuse.world.obstacles import (
     LinearObstacle,
     ObstacleSpec,

@@ -54,7 +54,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.grid import GridMap
-from pathfuse.world.geometry import segment_static_distance
+from pathfuse.sweep import segment_static_distance
 
 __all__ = [
     "LinearObstacle",

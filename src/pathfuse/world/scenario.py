@@ -71,8 +71,8 @@ from pathfuse import validate
 from pathfuse.grid import GridMap
 from pathfuse.limits import MAX_SEED, LimitError, env_name, limit
 from pathfuse.result import ConfigError, MapFormatError, PathfuseError
+from pathfuse.sweep import segment_static_distance
 from pathfuse.validate import short as _shown
-from pathfuse.world.geometry import segment_static_distance
 from pathfuse.world.obstacles import (
     LinearObstacle,
     ObstacleSpec,

@@ -33,13 +33,13 @@ Collisions (checked over the whole tick, not at its end points)
 ---------------------------------------------------------------
 * Static: the robot disc swept along its segment overlaps an occupied cell
   or leaves the map - exactly, with
-  :func:`~pathfuse.world.geometry.segment_static_distance` (closed-form
+  :func:`~pathfuse.sweep.segment_static_distance` (closed-form
   segment-to-square distances; no sampling, so no step size is too large).
   Along an arc: :func:`~pathfuse.sweep.arc_static_distance` (chords with a
   provable deviation bound, refined to 1e-9 m where it decides).
 * Moving discs: both centres move linearly over the tick, so their distance
   is minimised in closed form
-  (:func:`~pathfuse.world.geometry.disc_sweep_gaps`); along an arc,
+  (:func:`~pathfuse.sweep.disc_sweep_gaps`); along an arc,
   :func:`~pathfuse.sweep.arc_disc_gaps`.
 
 Who is at fault (``info["at_fault"]``)
@@ -92,15 +92,17 @@ from typing import Any
 
 import numpy as np
 
-from pathfuse.result import PathfuseError, QueryError
+from pathfuse.geometry import point_segment_distance
+from pathfuse.result import PathfuseError, QueryError, Status
 from pathfuse.shield import clip_holonomic, clip_unicycle
-from pathfuse.sweep import arc_disc_gaps, arc_static_distance, unicycle_pose
-from pathfuse.validate import short as _shown
-from pathfuse.world.geometry import (
+from pathfuse.sweep import (
+    arc_disc_gaps,
+    arc_static_distance,
     disc_sweep_gaps,
-    point_segment_distance,
     segment_static_distance,
+    unicycle_pose,
 )
+from pathfuse.validate import short as _shown
 from pathfuse.world.obstacles import obstacle_trajectories
 from pathfuse.world.scenario import Scenario, load_scenario
 
@@ -319,7 +321,8 @@ class World:
         truncated : bool
             The time limit was reached without termination.
         info : dict
-            ``event`` ("reached", "collision" or None), ``collision``
+            ``event`` ("reached", "collision" or None: the
+            :attr:`~pathfuse.result.Status.key` of the outcome), ``collision``
             ("static", the index of the disc hit, or None), ``static_gap``
             and ``obstacle_gap`` (least clearance over the tick, metres;
             ``inf`` without discs), ``clipped`` (speed limited), ``at_fault``
@@ -366,12 +369,12 @@ class World:
         collision: Any = None
         at_fault: bool | None = None
         if static_gap < 0.0:
-            event, collision, at_fault = "collision", "static", True
+            event, collision, at_fault = Status.COLLISION.key, "static", True
         elif hit_disc >= 0:
-            event, collision = "collision", hit_disc
+            event, collision = Status.COLLISION.key, hit_disc
             at_fault = self._moving(cmd)
         elif self._passes_goal(p0, p1, th0, cmd, arc):
-            event = "reached"
+            event = Status.SUCCESS.key
         self.position = p1
         self.velocity = (p1 - p0) / self.dt if self.diff_drive else cmd
         self.heading = float(th1)

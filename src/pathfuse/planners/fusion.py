@@ -1,7 +1,9 @@
 """The A*-APF fusion planner (paper Section III.C, Algorithm 2), registered as ``"fusion"``.
 
 Step 1 plans a global path with grid A*
-(:mod:`pathfuse.planners.global_astar`); if A* fails its status is returned.
+(:mod:`pathfuse.planners.global_astar`), or with the global planner that the
+parameter ``global_planner`` names (ours: any registered one, a plug-in's
+too); if it fails its status is returned.
 Step 2 starts the robot at ``start`` and repeats, until the goal is reached:
 
 * every A* path point strictly inside the circle of radius ``r1_m`` around
@@ -85,7 +87,7 @@ from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController, sensed_discs
-from pathfuse.planners.params import DiscParams, FieldParams, GlobalAStarParams
+from pathfuse.planners.params import DiscParams, FieldParams, GlobalAStarParams, GlobalChoice
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
 from pathfuse.validate import param
@@ -99,7 +101,7 @@ FUSION_STEP_FRAC = 0.5
 
 
 @dataclass(frozen=True)
-class FusionParams(GlobalAStarParams, DiscParams, FieldParams):
+class FusionParams(GlobalAStarParams, DiscParams, FieldParams, GlobalChoice):
     """Parameters of the fusion planner (paper values for K_att, K_rep, rho_0).
 
     The default ``step_m`` offline is :data:`FUSION_STEP_FRAC` (0.5) x the map
@@ -230,21 +232,28 @@ class FusionController(FieldController):
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:
+        return (fusion_loop,)
+
+    @classmethod
+    def diff_drive_kernels(cls) -> Sequence[Any]:
         from pathfuse.planners.dwa_kernel import dwa_choose
 
-        return (fusion_loop, dwa_choose)
+        return (dwa_choose,)
 
     @classmethod
     def warmup(cls) -> None:
         if _WARM[0]:
             return
-        from pathfuse.planners.dwa import DWAController
-
-        DWAController.warmup()  # the velocity-space fusion scores with dwa's window
         g = GridMap.from_rows(["....", ".#..", "...."])
         path = [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
         follow_path(g, (0.5, 0.5), (3.5, 2.5), path)
         _WARM[0] = True
+
+    @classmethod
+    def warmup_diff_drive(cls) -> None:
+        from pathfuse.planners.dwa import DWAController
+
+        DWAController.warmup()  # the velocity-space fusion scores with dwa's window
 
 
 _WARM = [False]

@@ -9,6 +9,7 @@ dwa follow its global path.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import subprocess
@@ -59,18 +60,11 @@ def _entry_points_of_example() -> str:
 
 @pytest.fixture
 def fresh_plugins(monkeypatch):
-    """Let :func:`registry.load_plugins` run again on this test's path; afterwards, drop
-    what the plug-ins registered."""
-    before = (dict(registry.REGISTRY), dict(registry.GLOBAL_PLANNERS),
-              dict(registry.CONTROLLERS), list(registry._PLUGINS_DONE))
+    """Let :func:`registry.load_plugins` run again on this test's path (conftest.py gives
+    the registry back afterwards)."""
     registry._load_builtin()
     monkeypatch.setattr(registry, "_PLUGINS_DONE", [])
-    yield monkeypatch
-    for table, old in zip((registry.REGISTRY, registry.GLOBAL_PLANNERS, registry.CONTROLLERS),
-                          before[:3], strict=True):
-        table.clear()
-        table.update(old)
-    registry._DEFAULTS.clear()
+    return monkeypatch
 
 
 @pytest.fixture
@@ -147,7 +141,11 @@ def test_cli_lists_and_plans_with_the_plugin(tmp_path):
                        text=True)
     assert p.returncode == 0, p.stderr
     d = json.loads(p.stdout)
-    assert d["status"] == "SUCCESS" and d["info"]["global_planner"] == "bfs4"
+    assert d["status"] == "SUCCESS" and d["global_planner"] == "bfs4"
+    p = subprocess.run([*cmd, "plan", "--map", "paper", "--planner", "bfs4", "--json"], env=env,
+                       capture_output=True, text=True)
+    path = np.array(json.loads(p.stdout)["path"])
+    assert np.allclose(np.abs(np.diff(path[1:-1], axis=0)).sum(axis=1), 1.0)  # 4-connected
 
 
 def test_a_broken_plugin_is_named(tmp_path, fresh_plugins):
@@ -209,3 +207,36 @@ def test_preset_equals_follower_with_its_global_planner():
         a = plan(ROOM, START, GOAL, planner=name, robot_radius_m=0.1)
         b = plan(ROOM, START, GOAL, planner="astar", global_planner=name, robot_radius_m=0.1)
         assert np.array_equal(a.path, b.path) and a.length == b.length
+
+
+def test_an_experiment_combines_global_planners_with_a_controller(tmp_path):
+    from pathfuse.bench.experiment import parse_experiment
+    from pathfuse.planners.fusion import FusionParams
+
+    text = """
+name: gp
+seeds: 1
+maps:
+  - name: tiny
+    map: {rows: ["......", ".##...", "......", "...#.."]}
+    start: [0.5, 0.5]
+    goal: [5.5, 3.5]
+planners:
+  - fusion
+  - name: fusion
+    params: {global_planner: [jps, thetastar]}
+  - name: dwa
+    params: {global_planner: shortest}
+"""
+    runs = parse_experiment(text, tmp_path / "gp.yaml").expand()
+    assert [r.full_params.get("global_planner") for r in runs] == \
+        [None, "jps", "thetastar", "shortest"]
+    # a run on the preset's own global planner hashes what it hashed before the parameter
+    # existed, so the runs a study stored then are found again
+    old = {k: v for k, v in dataclasses.asdict(FusionParams()).items()
+           if k != "global_planner"}
+    assert runs[0].full_params == json.loads(json.dumps(old))
+    assert len({r.key for r in runs}) == 4
+    with pytest.raises(ConfigError, match=r"planners\[1\]\.params\.global_planner\[1\]: "
+                                          r"must be one of astar, jps, .*got 'nope'$"):
+        parse_experiment(text.replace("[jps, thetastar]", "[jps, nope]"), tmp_path / "x.yaml")

@@ -28,6 +28,7 @@ from pathfuse.validate import short as _shown
 # --------------------------------------------------------------------------- commands
 def cmd_plan(args: argparse.Namespace) -> int:
     import pathfuse
+    from pathfuse.api import plan_query
     from pathfuse.generate import PAPER_GOAL, PAPER_START
 
     grid = _load_map(args)
@@ -42,8 +43,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
         args.plot = output_file(args.plot, "--plot", ".png")
     budget = pathfuse.Budget(time_limit_s=args.time_limit) if args.time_limit else None
     _warm_query(args.planner, params, args.robot_radius)
-    result = pathfuse.plan(grid, start, goal, planner=args.planner, budget=budget,
-                           robot_radius_m=args.robot_radius, **params)
+    result, spec, cfg, _ = plan_query(grid, start, goal, args.planner, params, budget=budget,
+                                      robot_radius_m=args.robot_radius)
+    global_planner = spec.global_planner_of(cfg)
     if args.plot:
         from pathfuse.viz import plot_plan
 
@@ -56,10 +58,12 @@ def cmd_plan(args: argparse.Namespace) -> int:
         d = result.to_dict()
         d["map"] = grid.name
         d["start"], d["goal"] = list(start), list(goal)
+        d["global_planner"] = global_planner
         print(json.dumps(d))
     else:
         print(f"map       {grid.name}  ({grid.width} x {grid.height} cells, {grid.resolution:g} m)")
-        print(f"planner   {result.planner}")
+        also = f"  (global planner {global_planner})" if global_planner else ""
+        print(f"planner   {result.planner}{also}")
         print(f"status    {result.status.name}  {result.message}")
         print(f"length    {result.length:.4f} m  ({len(result.path)} points)")
         print(f"time      {result.time_s * 1e3:.3f} ms")

@@ -180,6 +180,7 @@ def plan_request(store: MapStore, body: Any, limits: Limits) -> dict[str, Any]:
     d = result.to_dict()
     d["map"] = grid.name
     d["start"], d["goal"] = list(start), list(goal)
+    d["global_planner"] = spec.global_planner_of(cfg)
     if not extras:
         return d
     from pathfuse.metrics import evaluate

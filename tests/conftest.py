@@ -1,8 +1,8 @@
 """Shared test set-up: keep the planner registry as the library ships it.
 
 Some tests register plug-in planners, global planners or controllers (directly,
-or by running an experiment whose ``imports:`` registers one).  Each test gets the registry back as it
-was before it ran, so no test sees another test's plug-ins.
+or by running an experiment whose ``imports:`` registers one).  Each test gets the
+registry back as it was before it ran, so no test sees another test's plug-ins.
 """
 
 import pytest

@@ -110,9 +110,7 @@ def test_scen_counts_matches_and_fails_on_mismatch(tmp_path):
 
 
 def test_planners_lists_the_registry():
-    from pathfuse.planners.registry import planner_names
-
-    from pathfuse.planners.registry import controller_names, global_planner_names
+    from pathfuse.planners.registry import controller_names, global_planner_names, planner_names
 
     p = run("planners", "--json")
     assert p.returncode == 0

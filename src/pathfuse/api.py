@@ -123,9 +123,10 @@ def plan(
     'START_OCCUPIED'
     >>> plan(g, (0.5, 0.5), (3.5, 2.5), robot_radius_m=0.6).status.name
     'START_OCCUPIED'
-    >>> round(plan(g, (0.5, 0.5), (3.5, 2.5), planner="fusion",
-    ...            global_planner="thetastar").info["astar_length"], 4)
-    4.4721
+    >>> g2 = GridMap.from_rows(["......", "..#...", "..#...", "......"])
+    >>> [round(plan(g2, (0.5, 0.5), (5.5, 3.5), planner="fusion", global_planner=gp)
+    ...        .info["astar_length"], 4) for gp in ("astar", "thetastar")]
+    [6.8284, 6.6056]
     """
     return plan_query(grid, start, goal, planner, params, robot_radius_m=robot_radius_m,
                       clearance_m=clearance_m, robot=robot, budget=budget).result

@@ -351,10 +351,13 @@ def get_controller(name: str) -> type[Controller]:
                           f"{_shown(name)}") from None
 
 
+_BUILTIN_CONTROLLERS = ("follow", "replan", "apf", "fusion", "ref6", "ref7", "dwa", "mppi")
+
+
 def controller_names() -> list[str]:
-    """Names of the registered controllers, in the order they were registered."""
+    """Names of the registered controllers: the built-in ones first, then plug-ins'."""
     _load_builtin()
-    return list(CONTROLLERS)
+    return _ordered(list(CONTROLLERS), _BUILTIN_CONTROLLERS)
 
 
 def _ordered(names: list[str], builtin: Sequence[str]) -> list[str]:
@@ -541,7 +544,7 @@ def catalogue() -> dict[str, Any]:
         }
     globals_ = {n: {"description": GLOBAL_PLANNERS[n].description,
                     "plugin": GLOBAL_PLANNERS[n].plugin} for n in global_planner_names()}
-    controllers = {n: {"label": getattr(cls, "label", "") or n,
+    controllers = {n: {"label": getattr(CONTROLLERS[n], "label", "") or n,
                        "planners": [p for p, d in planners.items() if d["controller"] == n]}
-                   for n, cls in CONTROLLERS.items()}
+                   for n in controller_names()}
     return {"planners": planners, "global_planners": globals_, "controllers": controllers}

@@ -334,7 +334,8 @@ def test_params_validation():
                        match=r"^astar\.corner_cutting: must be true or false, got 'yes'$"):
         pathfuse.plan(g, (0.5, 0.5), (1.5, 1.5), corner_cutting="yes")
     with pytest.raises(ConfigError, match=r"^astar\.heuristc: unknown parameter "
-                                          r"\(parameters: heuristic, corner_cutting, "
+                                          r"\(parameters: global_planner, heuristic, "
+                                          r"corner_cutting, "
                                           r"lookahead_time_s, .*, clear_carrot\)$"):
         pathfuse.plan(g, (0.5, 0.5), (1.5, 1.5), heuristc="octile")
     # the robot radius is a keyword of plan(), not a parameter
@@ -357,9 +358,10 @@ def test_registry_entry():
     assert spec.controller is FollowController and spec.function is None
     assert spec.params_cls is AStarParams and spec.global_planner == "astar"
     assert spec.uses_astar and spec.offline and spec.online and spec.description
-    # the search's parameters, then the diff-drive path follower's (planners/rpp.py)
-    assert spec.defaults() == {"heuristic": "euclidean", "corner_cutting": False,
-                               **dataclasses.asdict(PursuitParams())}
+    # the global planner it follows, the search's parameters, then the diff-drive path
+    # follower's (planners/rpp.py)
+    assert spec.defaults() == {"global_planner": "astar", "heuristic": "euclidean",
+                               "corner_cutting": False, **dataclasses.asdict(PursuitParams())}
     warm(spec)
     # the older name of the same planner
     assert get_planner("astar-follow") is spec

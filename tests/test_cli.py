@@ -110,11 +110,37 @@ def test_scen_counts_matches_and_fails_on_mismatch(tmp_path):
 
 
 def test_planners_lists_the_registry():
-    from pathfuse.planners.registry import planner_names
+    from pathfuse.planners.registry import controller_names, global_planner_names, planner_names
 
     p = run("planners", "--json")
     assert p.returncode == 0
-    assert sorted(json.loads(p.stdout)) == sorted(planner_names())
+    d = json.loads(p.stdout)
+    assert list(d["planners"]) == planner_names()
+    assert list(d["global_planners"]) == global_planner_names()
+    assert list(d["controllers"]) == controller_names()
+    assert d["planners"]["thetastar"]["controller"] == "follow"
+    assert "thetastar" in d["controllers"]["follow"]["planners"]
+    text = run("planners").stdout
+    assert "\nglobal planners" in text and "\njps\n  jump point search" in text
+    assert "\nfusion  (Algorithm 2): planners fusion" in text
+
+
+def test_global_planner_option(tmp_path):
+    p = run("plan", "--map", "paper", "--planner", "fusion", "--global-planner", "thetastar",
+            "--json")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert d["global_planner"] == "thetastar" and d["status"] == "SUCCESS"
+    a = json.loads(run("plan", "--map", "paper", "--planner", "fusion", "--json").stdout)
+    assert a["global_planner"] == "astar" and a["path"] != d["path"]
+    p = run("plan", "--map", "paper", "--planner", "fusion", "--global-planner", "nope")
+    assert p.returncode == 2 and p.stdout == ""
+    assert p.stderr.strip().splitlines() == [
+        "pathfuse plan: error: fusion.global_planner: must be one of astar, jps, astar-smooth, "
+        "thetastar, lazy-thetastar, shortest, got 'nope'"]
+    p = run("plan", "--map", "paper", "--planner", "fusion", "--global-planner", "jps",
+            "--param", "global_planner=astar")
+    assert p.returncode != 0 and "disagree" in p.stderr
 
 
 def test_negative_coordinates_are_accepted_on_a_ros_map():

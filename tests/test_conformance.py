@@ -25,7 +25,7 @@ from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate, path_length
 from pathfuse.planners.fusion import FusionParams
 from pathfuse.planners.global_astar import route
-from pathfuse.planners.registry import get_planner, make_params, planner_names
+from pathfuse.planners.registry import get_global_planner, get_planner, make_params, planner_names
 from pathfuse.planners.run import warm
 from pathfuse.problem import Problem
 
@@ -61,7 +61,7 @@ def counts_expansions(name):
 def test_all_builtin_planners_are_registered():
     assert {"astar", "astar-replan", "apf", "fusion", "ref6", "ref7"} <= set(NAMES)
     # every built-in planner runs offline and online
-    for name in ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7", "dwa"):
+    for name in ("astar", "astar-replan", "apf", "fusion", "ref6", "ref7", "dwa", "jps"):
         spec = get_planner(name)
         assert spec.offline and spec.online and spec.capabilities() == ("offline", "online")
     assert get_planner("astar-follow").name == "astar"
@@ -192,14 +192,16 @@ def test_unreachable_goal(name):
 @pytest.mark.parametrize("name", NAMES)
 @pytest.mark.parametrize("cap", [1, 3])
 def test_iteration_cap(name, cap):
-    if name == "shortest":
-        cap = 1  # one expansion (the start) never reaches the goal, even here
+    if name in ("shortest", "jps"):
+        # one expansion (the start) never reaches the goal, even here; but the start's
+        # jump east (jps) or sight line (shortest) finds the goal, expanded second
+        cap = 1
     r = plan(CORRIDOR, (0.5, 2.5), (38.5, 2.5), planner=name, budget=Budget(max_iterations=cap))
     check_bookkeeping(r, name)
     assert r.status is Status.MAX_ITERATIONS
     # the cap counts expansions for grid A*, force steps for the potential-field planners
     assert (r.expansions if counts_expansions(name) else r.iterations) == cap
-    if name == "shortest":
+    if name in ("shortest", "jps"):
         # the visibility graph of this corridor has no corner: the start sees the goal, so
         # two expansions suffice; on a map with obstacles the cap stops it likewise
         g = paper_map(0)
@@ -313,9 +315,16 @@ def check_episode(ep, name, sc):
         g = ep.scenario.grid
         if spec.uses_astar:
             want = route(g, sc["start"], sc["goal"], sc["robot"]["radius"])
-        else:  # an any-angle planner: its global path is what plan() returns
-            want = plan(g, sc["start"], sc["goal"], planner=name,
-                        robot_radius_m=sc["robot"]["radius"]).path
+        else:  # another global planner: the waypoints of its plan on the static map (an
+            # any-angle planner's are what plan() returns)
+            from pathfuse.planners.global_planners import run_global
+
+            pb = Problem.create(g, sc["start"], sc["goal"], sc["robot"]["radius"])
+            want = run_global(spec.global_planner, pb).waypoints
+            if get_global_planner(spec.global_planner).taut:
+                np.testing.assert_array_equal(
+                    want, plan(g, sc["start"], sc["goal"], planner=name,
+                               robot_radius_m=sc["robot"]["radius"]).path)
         np.testing.assert_array_equal(ep.global_path, want)
         assert ep.path_updates[0][0] == 0
     elif not spec.has_global_plan:

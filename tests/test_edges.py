@@ -20,7 +20,7 @@ from pathfuse.planners.registry import planner_names
 
 EMPTY = GridMap.from_rows(["......"] * 3)          # [0, 6) x [0, 3)
 PLANNERS = sorted(planner_names())
-CELL_PATHS = ("astar", "astar-replan")  # offline: cell centres from start cell to goal cell
+CELL_PATHS = ("astar", "astar-replan", "jps")  # offline: cell centres, start cell to goal cell
 
 
 def _check(res, grid, goal, radius=0.0):

@@ -109,7 +109,7 @@ def _drive(doc, planner, params=None, seed=None):
 # ----------------------------------------------------------------------------- registry
 def test_registry_names_and_parameter_errors():
     # one registry: every built-in planner runs online (the any-angle ones follow their path)
-    any_angle = ["astar-smooth", "thetastar", "lazy-thetastar", "shortest"]
+    any_angle = ["astar-smooth", "thetastar", "lazy-thetastar", "shortest", "jps"]
     assert sorted(n for n in planner_names() if get_planner(n).online) == sorted(
         PLANNERS + any_angle)
     assert all(get_planner(n).offline for n in PLANNERS)

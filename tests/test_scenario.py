@@ -141,8 +141,8 @@ MALFORMED = [
     ("planner.name", ..., "planner.name: missing"),
     ("planner.params", [1], "planner.params: must be a mapping"),
     ("planner.params", {"k_att": -1}, "planner.params.k_att: must be a number > 0, got -1"),
-    ("planner.params", {"kat": 1}, "planner.params.kat: unknown parameter (parameters: k_att, "
-                                   "k_rep, rho0_m"),
+    ("planner.params", {"kat": 1}, "planner.params.kat: unknown parameter (parameters: "
+                                   "global_planner, k_att, k_rep, rho0_m"),
     ("planner.params", {"escape_ticks": 20}, "planner.params.escape_ticks: unknown parameter"),
     ("planner.params", {"robot_radius_m": 0.2}, "planner.params.robot_radius_m: unknown "
                                                 "parameter"),

@@ -102,7 +102,10 @@ def test_planners_loop_over_the_registry(client):
             assert q["default"] == getattr(defaults, q["name"])
             assert q["kind"] in ("float", "int", "bool", "choice", "str")
             ps = param_spec(f)
-            if ps is not None:  # declared with param(): its metadata (test plug-ins may not)
+            if q["name"] == "global_planner":  # a choice among the registered ones
+                assert q["kind"] == "choice" and q["choices"] == pathfuse.global_planner_names()
+                assert q["help"] == ps.help
+            elif ps is not None:  # declared with param(): its metadata (plug-ins may not)
                 assert q["help"] == ps.help and q["unit"] == ps.unit and q["kind"] == ps.kind
         assert ("closed" in p["layers"]) == spec.uses_astar
     fusion = next(p for p in got if p["name"] == "fusion")

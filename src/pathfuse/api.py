@@ -1,16 +1,47 @@
-"""The one-call entry point: :func:`plan`."""
+"""The one-call entry point: :func:`plan` (and :func:`plan_query`, the same body for
+callers that hold the parameters as a mapping, as the playground's server does)."""
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, NamedTuple
 
 from pathfuse.grid import GridMap
-from pathfuse.planners.registry import get_planner, make_params
+from pathfuse.planners.registry import PlannerSpec, get_planner, make_params
 from pathfuse.planners.run import solve
 from pathfuse.problem import Problem
 from pathfuse.result import Budget, PlanResult
 
-__all__ = ["plan"]
+__all__ = ["plan", "plan_query", "Planned"]
+
+
+class Planned(NamedTuple):
+    """What :func:`plan_query` returns: the result and what it was planned with."""
+
+    result: PlanResult
+    spec: PlannerSpec
+    params: Any
+    problem: Problem
+
+
+def plan_query(grid: GridMap, start: object, goal: object, planner: str = "astar",
+               params: Mapping[str, Any] | None = None, *,
+               robot_radius_m: float | None = None, clearance_m: float = 0.0,
+               robot: Any = None, budget: Budget | None = None) -> Planned:
+    """The body of :func:`plan`, with the planner's parameters as a mapping (no clash with
+    the keywords): the result, the planner's spec, its parameters and the problem.
+
+    >>> g = GridMap.from_rows(["....", ".##.", "...."])
+    >>> q = plan_query(g, (0.5, 0.5), (3.5, 2.5), "fusion", {"global_planner": "jps"})
+    >>> q.result.status.name, q.params.global_planner, q.spec.name
+    ('SUCCESS', 'jps', 'fusion')
+    """
+    spec = get_planner(planner)
+    cfg = make_params(spec, params)
+    if robot_radius_m is None:
+        robot_radius_m = getattr(robot, "radius_m", 0.0)
+    problem = Problem.create(grid, start, goal, robot_radius_m, budget, clearance_m, robot)
+    return Planned(solve(spec, problem, cfg), spec, cfg, problem)
 
 
 def plan(
@@ -39,6 +70,11 @@ def plan(
         World coordinates in metres.
     planner : str
         A name from :func:`pathfuse.planner_names` (``pathfuse planners``).
+    global_planner : str, optional
+        (A planner parameter.)  The global planner whose path the planner's
+        controller follows, a name of :func:`pathfuse.global_planner_names`
+        (plug-ins' included); default: the planner's own.  Every planner with
+        a global planner takes it (not ``apf``, ``astar-replan``, ``mppi``).
     robot_radius_m : float
         Radius of a disc robot (default 0: a point; with ``robot``, its
         radius).  The global planner searches the map with obstacles and the
@@ -87,10 +123,10 @@ def plan(
     'START_OCCUPIED'
     >>> plan(g, (0.5, 0.5), (3.5, 2.5), robot_radius_m=0.6).status.name
     'START_OCCUPIED'
+    >>> g2 = GridMap.from_rows(["......", "..#...", "..#...", "......"])
+    >>> [round(plan(g2, (0.5, 0.5), (5.5, 3.5), planner="fusion", global_planner=gp)
+    ...        .info["astar_length"], 4) for gp in ("astar", "thetastar")]
+    [6.8284, 6.6056]
     """
-    spec = get_planner(planner)
-    cfg = make_params(spec, params)
-    if robot_radius_m is None:
-        robot_radius_m = getattr(robot, "radius_m", 0.0)
-    return solve(spec, Problem.create(grid, start, goal, robot_radius_m, budget, clearance_m,
-                                      robot), cfg)
+    return plan_query(grid, start, goal, planner, params, robot_radius_m=robot_radius_m,
+                      clearance_m=clearance_m, robot=robot, budget=budget).result

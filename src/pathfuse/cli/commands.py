@@ -28,6 +28,7 @@ from pathfuse.validate import short as _shown
 # --------------------------------------------------------------------------- commands
 def cmd_plan(args: argparse.Namespace) -> int:
     import pathfuse
+    from pathfuse.api import plan_query
     from pathfuse.generate import PAPER_GOAL, PAPER_START
 
     grid = _load_map(args)
@@ -37,13 +38,14 @@ def cmd_plan(args: argparse.Namespace) -> int:
             raise CliError("--start and --goal are required unless --map paper")
     start = parse_point(args.start, "--start") if args.start else PAPER_START
     goal = parse_point(args.goal, "--goal") if args.goal else PAPER_GOAL
-    params = parse_params(args.param)
+    params = with_global_planner(parse_params(args.param), args.global_planner)
     if args.plot:
         args.plot = output_file(args.plot, "--plot", ".png")
     budget = pathfuse.Budget(time_limit_s=args.time_limit) if args.time_limit else None
-    _warm_with_notice(args.planner)
-    result = pathfuse.plan(grid, start, goal, planner=args.planner, budget=budget,
-                           robot_radius_m=args.robot_radius, **params)
+    _warm_query(args.planner, params, args.robot_radius)
+    result, spec, cfg, _ = plan_query(grid, start, goal, args.planner, params, budget=budget,
+                                      robot_radius_m=args.robot_radius)
+    global_planner = spec.global_planner_of(cfg)
     if args.plot:
         from pathfuse.viz import plot_plan
 
@@ -56,10 +58,12 @@ def cmd_plan(args: argparse.Namespace) -> int:
         d = result.to_dict()
         d["map"] = grid.name
         d["start"], d["goal"] = list(start), list(goal)
+        d["global_planner"] = global_planner
         print(json.dumps(d))
     else:
         print(f"map       {grid.name}  ({grid.width} x {grid.height} cells, {grid.resolution:g} m)")
-        print(f"planner   {result.planner}")
+        also = f"  (global planner {global_planner})" if global_planner else ""
+        print(f"planner   {result.planner}{also}")
         print(f"status    {result.status.name}  {result.message}")
         print(f"length    {result.length:.4f} m  ({len(result.path)} points)")
         print(f"time      {result.time_s * 1e3:.3f} ms")
@@ -131,31 +135,37 @@ def _warm_with_notice(planner: str | Sequence[str], world: bool = False) -> None
     warm_kernels(names, metrics=False, world=world, notify=notice)
 
 
+def _warm_query(planner: str, params: dict[str, Any], robot_radius_m: float) -> None:
+    """Compile the kernels one plan runs (its global planner's and controller's only),
+    saying so first, in one line, when numba's cache is cold."""
+    from pathfuse.planners.registry import get_planner, make_params
+    from pathfuse.planners.run import warm_query
+
+    def notice() -> None:
+        print(f"pathfuse: compiling the kernels of {planner} (first run only; cached "
+              "afterwards)", file=sys.stderr, flush=True)
+
+    spec = get_planner(planner)
+    warm_query(spec, make_params(spec, params), robot_radius_m, notice)
+
+
+def with_global_planner(params: dict[str, Any], name: str | None) -> dict[str, Any]:
+    """``params`` with ``global_planner`` set from ``--global-planner`` (when given; the
+    option and ``--param global_planner=...`` must agree)."""
+    if name is None:
+        return params
+    if params.get("global_planner", name) != name:
+        raise CliError(f"--global-planner {name} and --param global_planner="
+                       f"{params['global_planner']} disagree")
+    return {**params, "global_planner": name}
+
+
 def planner_table() -> dict[str, Any]:
-    """Every registered planner as JSON-ready data (what ``pathfuse planners --json`` prints)."""
-    import dataclasses
+    """The registry's catalogue (what ``pathfuse planners --json`` prints; the playground's
+    forms come from the same :func:`pathfuse.planners.registry.catalogue`)."""
+    from pathfuse.planners.registry import catalogue
 
-    from pathfuse.planners.registry import REGISTRY, planner_names
-    from pathfuse.validate import param_spec
-
-    out: dict[str, Any] = {}
-    for n in planner_names():
-        spec = REGISTRY[n]
-        params = []
-        for f in dataclasses.fields(spec.params_cls):
-            ps = param_spec(f)
-            default = getattr(spec.params_cls(), f.name)
-            params.append({
-                "name": f.name, "default": default,
-                "kind": ps.kind if ps else "", "unit": ps.unit if ps else "",
-                "accepts": ps.describe() if ps else "", "help": ps.help if ps else "",
-            })
-        ctrl = getattr(spec.controller, "label", "") if spec.controller else ""
-        out[n] = {"description": spec.description, "offline": spec.offline,
-                  "online": spec.online, "global_planner": spec.global_planner,
-                  "controller": ctrl or None, "aliases": list(spec.aliases),
-                  "params": params}
-    return out
+    return catalogue()
 
 
 def cmd_planners(args: argparse.Namespace) -> int:
@@ -163,11 +173,14 @@ def cmd_planners(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(table))
         return 0
-    for name, d in table.items():
+    print("planners (a global planner, a controller and their parameters):\n")
+    for name, d in table["planners"].items():
         runs = " and ".join(k for k in ("offline", "online") if d[k])
         also = f"; also called {', '.join(d['aliases'])}" if d["aliases"] else ""
         gp = d["global_planner"]
-        parts = [f"global planner: {'A*' if gp == 'astar' else gp}" if gp else "",
+        if gp and d["any_global_planner"]:
+            gp += " or any (global_planner)"
+        parts = [f"global planner: {gp}" if gp else "",
                  f"controller: {d['controller']}" if d["controller"] else "a plug-in function"]
         print(f"{name}  ({'; '.join(x for x in parts if x)}; runs {runs}{also})")
         print(f"  {d['description']}")
@@ -178,6 +191,13 @@ def cmd_planners(args: argparse.Namespace) -> int:
         else:
             shown = ", ".join(f"{p['name']}={p['default']!r}" for p in d["params"])
             print(f"  parameters: {shown or 'none'}")
+    print("\nglobal planners (--global-planner NAME, or the parameter global_planner):\n")
+    for name, d in table["global_planners"].items():
+        origin = f"  [plug-in {d['plugin']}]" if d["plugin"] else ""
+        print(f"{name}{origin}\n  {d['description']}")
+    print("\ncontrollers:\n")
+    for name, d in table["controllers"].items():
+        print(f"{name}  ({d['label']}): planners {', '.join(d['planners']) or 'none'}")
     if not args.params:
         print("\n'pathfuse planners --params' explains every parameter (unit, range, meaning).")
     return 0
@@ -274,7 +294,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
     args.scenario = resolve(args.scenario, "scenario")
     sc = load_scenario(args.scenario)
-    params = parse_params(args.param)
+    params = with_global_planner(parse_params(args.param), args.global_planner)
     if args.planner is None or args.planner == sc.planner.name:
         # the scenario's own planner keeps the scenario's parameters (--param overrides them)
         choice = {"name": args.planner or sc.planner.name,

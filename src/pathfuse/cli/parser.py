@@ -61,6 +61,7 @@ examples:
   pathfuse plan --map tests/data/ros/nav2_tb3_sandbox/tb3_sandbox.pgm --resolution 0.05 \
       --start 9.0,9.5 --goal 11.5,10.5 --json
   pathfuse plan --map paper --planner astar --param heuristic=octile
+  pathfuse plan --map paper --planner fusion --global-planner thetastar
 
 --map accepts: 'paper' (the paper's random 15 m map, --seed N), a MovingAI .map,
 a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolution).
@@ -71,6 +72,9 @@ a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolu
     p.add_argument("--start", help="start X,Y in metres (default for --map paper: 1,1)")
     p.add_argument("--goal", help="goal X,Y in metres (default for --map paper: 11,11)")
     p.add_argument("--planner", default="astar", help="planner name (see 'pathfuse planners')")
+    p.add_argument("--global-planner", metavar="NAME",
+                   help="the global planner whose path the controller follows (default: "
+                   "the planner's own; see 'pathfuse planners')")
     p.add_argument("--param", action="append", metavar="KEY=VALUE",
                    help="planner parameter, repeatable (e.g. --param heuristic=octile)")
     p.add_argument("--resolution", type=_float, help="metres per cell for image/.npy maps")
@@ -176,6 +180,9 @@ an animation plays in real time unless that takes more than 150 frames, then fas
     sm.add_argument("scenario", help="scenario YAML file, or the name of a shipped one "
                     "('pathfuse examples' lists them)")
     sm.add_argument("--planner", help="planner (default: the scenario's)")
+    sm.add_argument("--global-planner", metavar="NAME",
+                    help="the global planner whose path the controller follows (default: "
+                   "the planner's own; see 'pathfuse planners')")
     sm.add_argument("--param", action="append", metavar="KEY=VALUE",
                     help="planner parameter, repeatable (e.g. --param repulsion=velocity)")
     sm.add_argument("--seed", type=_nonneg_int, default=None,
@@ -335,7 +342,8 @@ with one configuration; by default R_length is against the experiment's own refe
         "planners", help="list the registered planners and their parameters",
         description="List every planner in the registry: its global planner and controller, "
         "whether it runs offline (pathfuse plan) and online (pathfuse simulate), and its "
-        "parameters with their defaults.",
+        "parameters with their defaults; then the global planners and the controllers "
+        "(plug-ins' included).",
         epilog="examples:\n  pathfuse planners\n  pathfuse planners --params\n"
                "  pathfuse planners --json",
         formatter_class=argparse.RawDescriptionHelpFormatter,

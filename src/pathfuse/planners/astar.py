@@ -53,9 +53,8 @@ from numba import njit
 
 from pathfuse.planners.base import Controller, Observed, Outcome
 from pathfuse.planners.global_astar import plan_global
-from pathfuse.planners.params import GlobalAStarParams, PursuitParams
+from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, PursuitParams
 from pathfuse.planners.registry import PlannerSpec, register
-from pathfuse.planners.rpp import RegulatedPurePursuit, rpp_step, warmup_rpp
 from pathfuse.problem import Problem
 from pathfuse.result import Status
 from pathfuse.validate import param
@@ -82,9 +81,10 @@ class _Replanning(GlobalAStarParams):
 # the follower's parameters come last (their base class first: dataclass fields are
 # collected from the last base class to the first)
 @dataclass(frozen=True)
-class AStarParams(PursuitParams, _AStarSearch):
-    """Parameters of the ``astar`` planner: its search, and its path follower's on a
-    diff-drive robot (:class:`~pathfuse.planners.params.PursuitParams`)."""
+class AStarParams(PursuitParams, _AStarSearch, GlobalChoice):
+    """Parameters of the ``astar`` planner: the global planner it follows (grid A* by
+    default), A*'s search, and its path follower's on a diff-drive robot
+    (:class:`~pathfuse.planners.params.PursuitParams`)."""
 
 
 @dataclass(frozen=True)
@@ -109,14 +109,21 @@ def _cumlen(path: np.ndarray) -> np.ndarray:
 
 class FollowController(Controller):
     """Walk the global path at full speed (offline: return it as planned); on a diff-drive
-    robot, follow it with Regulated Pure Pursuit (:mod:`pathfuse.planners.rpp`)."""
+    robot, follow it with Regulated Pure Pursuit (:mod:`pathfuse.planners.rpp`).
 
-    name = "astar"
+    It follows the path of any global planner.  A taut path (an any-angle one, or a
+    plug-in's: :attr:`GlobalPlan.taut <pathfuse.planners.global_astar.GlobalPlan.taut>`)
+    turns where it touches the robot's clearance around an obstacle corner, so a move
+    across a corner would come closer than the radius: a holonomic robot's walk then ends
+    a tick's move on the next corner (at most one tick per corner, and these paths have
+    few).
+    """
+
+    name = "follow"
     label = "follow the path"
     search_budget: ClassVar[bool] = True
-    #: End a tick's move at the path's next corner instead of cutting across it (the
-    #: any-angle followers: their taut paths touch the robot's clearance at the corners;
-    #: a holonomic robot's walk only).
+    #: End a tick's move at the path's next corner instead of cutting across it, whatever
+    #: the plan (a holonomic robot's walk only; a taut plan does it anyway).
     stop_at_corners: ClassVar[bool] = False
 
     def __init__(self, problem: Problem, params: Any, plan: Any = None, **kw: Any) -> None:
@@ -126,9 +133,12 @@ class FollowController(Controller):
             self._cum = _cumlen(self._path)
             self._s = 0.0
             self._step = float(self.max_speed) * float(self.dt)  # type: ignore[arg-type]
-        self._rpp: RegulatedPurePursuit | None = None
+            self._corners = self.stop_at_corners or bool(getattr(plan, "taut", False))
+        self._rpp: Any = None
         rb = problem.robot
         if self.online and rb is not None and rb.is_diff_drive:
+            from pathfuse.planners.rpp import RegulatedPurePursuit
+
             dt, top = float(self.dt), float(self.max_speed)  # type: ignore[arg-type]
             self._rpp = RegulatedPurePursuit(problem, params, dt, top)
 
@@ -140,8 +150,14 @@ class FollowController(Controller):
 
     def run(self, deadline: float | None) -> Outcome:
         gp = self.plan
-        info = {"cells": gp.cells, "cost_cells": gp.length_m / self.problem.grid.resolution,
-                "heuristic": gp.heuristic, "corner_cutting": gp.corner_cutting}
+        if gp.taut or not len(gp.cells):  # an any-angle path, a plug-in's waypoints
+            info: dict[str, Any] = {"global_planner": gp.planner,
+                                    "corners": int(len(gp.points))}
+        else:
+            info = {"cells": gp.cells, "cost_cells": gp.length_m / self.problem.grid.resolution,
+                    "heuristic": gp.heuristic, "corner_cutting": gp.corner_cutting}
+            if gp.planner != "astar":
+                info["global_planner"] = gp.planner
         return Outcome(Status.SUCCESS, gp.points, 0, 0.0, gp.message, info, gp.length_m)
 
     def act(self, obs: Observed) -> np.ndarray:
@@ -149,7 +165,7 @@ class FollowController(Controller):
             return self._rpp.command(obs, self._path)
         cum = self._cum
         s = min(self._s + self._step, float(cum[-1]))
-        if self.stop_at_corners:
+        if self._corners:
             nxt = int(np.searchsorted(cum, self._s, side="right"))
             if nxt < len(cum) - 1 and cum[nxt] < s:
                 s = float(cum[nxt])
@@ -158,11 +174,15 @@ class FollowController(Controller):
         return (target - obs.position) / float(self.dt)  # type: ignore[no-any-return, arg-type]
 
     @classmethod
-    def kernels(cls) -> Sequence[Any]:
+    def diff_drive_kernels(cls) -> Sequence[Any]:
+        from pathfuse.planners.rpp import rpp_step
+
         return (rpp_step,)
 
     @classmethod
-    def warmup(cls) -> None:
+    def warmup_diff_drive(cls) -> None:
+        from pathfuse.planners.rpp import warmup_rpp
+
         warmup_rpp()
 
 
@@ -187,7 +207,7 @@ def _rasterise_discs(occ, ox, oy, res, pos, radii, grow):
 class ReplanController(FollowController):
     """A* replanned at a fixed rate around the sensed discs (see the module docstring)."""
 
-    name = "astar-replan"
+    name = "replan"
     label = "replan at a fixed rate and follow"
 
     def __init__(self, problem: Problem, params: Any, plan: Any = None, **kw: Any) -> None:
@@ -243,7 +263,8 @@ register(PlannerSpec(
     name="astar",
     params_cls=AStarParams,
     description="exact 8-connected grid A* (euclidean or octile heuristic, no corner cutting "
-                "by default); online it walks its path blind to moving discs",
+                "by default), or the path of any global_planner; online it walks the path "
+                "blind to moving discs",
     controller=FollowController,
     global_planner="astar",
     aliases=("astar-follow",),

@@ -307,6 +307,16 @@ class Controller:
     def warmup(cls) -> None:
         """Compile (or load from numba's cache) the kernels this controller runs."""
 
+    @classmethod
+    def diff_drive_kernels(cls) -> Sequence[Any]:
+        """The further kernels it runs online on a diff-drive robot only (compiled only
+        for such an episode: a command compiles what it runs)."""
+        return ()
+
+    @classmethod
+    def warmup_diff_drive(cls) -> None:
+        """Compile (or load) :meth:`diff_drive_kernels`."""
+
 
 class FieldController(Controller):
     """Shared logic of the potential-field controllers (see the module docstring).

@@ -1,8 +1,10 @@
 """The Dynamic Window Approach (Fox, Burgard and Thrun, IEEE RA Magazine 1997), as ``"dwa"``.
 
 The local planner that ships with ROS (move_base's ``dwa_local_planner``, Nav2's
-DWB) and the baseline of the BARN challenge: grid A* gives the global path,
-then every control period:
+DWB) and the baseline of the BARN challenge: grid A* gives the global path (or
+the global planner that ``global_planner`` names, which then also makes every
+replan, on the map with the sensed discs' cells blocked), then every control
+period:
 
 1. **The dynamic window.**  The commands reachable within one tick under the
    acceleration limits: for a diff-drive robot ``v`` in ``[v0 - a dt, v0 + a
@@ -92,7 +94,7 @@ from pathfuse.planners.dwa_kernel import (
     set_keep_reference,
     set_route,
 )
-from pathfuse.planners.params import GlobalAStarParams, SocialParams
+from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, SocialParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.planners.social import PassingSides, disc_ids
 from pathfuse.problem import Problem
@@ -105,7 +107,7 @@ __all__ = ["DWAParams", "DWAController"]
 
 
 @dataclass(frozen=True)
-class DWAParams(SocialParams, GlobalAStarParams):
+class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
     """Parameters of ``dwa`` (the sampling, the horizon and the critics' weights)."""
 
     v_samples: int = param(7, ge=2, help="linear speeds sampled in the window (holonomic: "
@@ -219,6 +221,9 @@ class DWAController(Controller):
         from pathfuse.planners.global_astar import plan_global
 
         pb = self.problem
+        if self.params.global_planner != "astar":
+            self._replan_with(self.params.global_planner, x, y)
+            return
         occ = None
         dpos, _, drad = self._sensed
         if drad.shape[0]:
@@ -233,6 +238,34 @@ class DWAController(Controller):
         gp = plan_global(pb.with_start((x, y)), self.params.heuristic, occupied=occ)
         if not gp.success and occ is not None:  # boxed in by the discs: the static path
             gp = plan_global(pb.with_start((x, y)), self.params.heuristic)
+        self.replans += 1
+        if gp.success:
+            self._set_path(np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2))
+            self.global_path = self.pts
+
+    def _replan_with(self, name: str, x: float, y: float) -> None:
+        """Replan with the registered global planner ``name`` (not A*): on the map with the
+        sensed discs' cells blocked (a global planner sees a map, not discs), or, when
+        that leaves no path or boxes the robot in, on the static map."""
+        from pathfuse.planners.global_planners import run_global
+
+        pb = self.problem
+        here = pb.with_start((x, y))
+        dpos, _, drad = self._sensed
+        gp = None
+        if drad.shape[0]:
+            from pathfuse.planners.astar import _rasterise_discs
+
+            g = pb.grid
+            occ = g.occupied.copy()
+            _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
+                             dpos, drad, 0.0)
+            crowded = Problem.create(g.with_occupied(occ), (x, y), pb.goal, pb.robot_radius_m,
+                                     pb.budget, pb.clearance_m, pb.robot)
+            if crowded.failure() is None:
+                gp = run_global(name, crowded, self.params)
+        if gp is None or not gp.success:
+            gp = run_global(name, here, self.params)
         self.replans += 1
         if gp.success:
             self._set_path(np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2))

@@ -1,7 +1,9 @@
 """The A*-APF fusion planner (paper Section III.C, Algorithm 2), registered as ``"fusion"``.
 
 Step 1 plans a global path with grid A*
-(:mod:`pathfuse.planners.global_astar`); if A* fails its status is returned.
+(:mod:`pathfuse.planners.global_astar`), or with the global planner that the
+parameter ``global_planner`` names (ours: any registered one, a plug-in's
+too); if it fails its status is returned.
 Step 2 starts the robot at ``start`` and repeats, until the goal is reached:
 
 * every A* path point strictly inside the circle of radius ``r1_m`` around
@@ -89,6 +91,7 @@ from pathfuse.planners.params import (
     DiscParams,
     FieldParams,
     GlobalAStarParams,
+    GlobalChoice,
     SocialParams,
 )
 from pathfuse.planners.registry import PlannerSpec, register
@@ -104,7 +107,7 @@ FUSION_STEP_FRAC = 0.5
 
 
 @dataclass(frozen=True)
-class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams):
+class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, GlobalChoice):
     """Parameters of the fusion planner (paper values for K_att, K_rep, rho_0).
 
     The default ``step_m`` offline is :data:`FUSION_STEP_FRAC` (0.5) x the map
@@ -256,21 +259,28 @@ class FusionController(FieldController):
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:
-        from pathfuse.planners.dwa_kernel import dwa_choose
+        return (fusion_loop,)
 
-        return (fusion_loop, dwa_choose)
+    @classmethod
+    def diff_drive_kernels(cls) -> Sequence[Any]:
+        from pathfuse.planners.dwa_kernel import dwa_choose, route_tangent
+
+        return (dwa_choose, route_tangent)
 
     @classmethod
     def warmup(cls) -> None:
         if _WARM[0]:
             return
-        from pathfuse.planners.dwa import DWAController
-
-        DWAController.warmup()  # the velocity-space fusion scores with dwa's window
         g = GridMap.from_rows(["....", ".#..", "...."])
         path = [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
         follow_path(g, (0.5, 0.5), (3.5, 2.5), path)
         _WARM[0] = True
+
+    @classmethod
+    def warmup_diff_drive(cls) -> None:
+        from pathfuse.planners.dwa import DWAController
+
+        DWAController.warmup()  # the velocity-space fusion scores with dwa's window
 
 
 _WARM = [False]

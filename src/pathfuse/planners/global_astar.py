@@ -38,6 +38,7 @@ import math
 import time
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -84,6 +85,11 @@ class GlobalPlan:
     message : str
     heuristic : str
     corner_cutting : bool
+    planner : str
+        The registered global planner that made it (``astar``, ``jps``, a plug-in).
+    taut : bool
+        Whether the path turns where it touches the robot's clearance (an
+        any-angle path): a holonomic follower stops on each corner.
     """
 
     status: Status
@@ -96,6 +102,8 @@ class GlobalPlan:
     message: str = ""
     heuristic: str = "euclidean"
     corner_cutting: bool = False
+    planner: str = "astar"
+    taut: bool = False
 
     @property
     def success(self) -> bool:
@@ -135,7 +143,7 @@ def snap_cell(occ: np.ndarray, grid: GridMap, p: tuple[float, float],
 
 def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: bool = False,
                 occupied: np.ndarray | None = None, max_expansions: int | None = None,
-                time_limit_s: float | None = None) -> GlobalPlan:
+                time_limit_s: float | None = None, jps: bool = False) -> GlobalPlan:
     """Grid A* for ``problem`` (its start and goal must be free: :meth:`Problem.failure`).
 
     Parameters
@@ -153,6 +161,10 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
         cap beyond the number of free cells).
     time_limit_s : float, optional
         Default: the problem's budget.
+    jps : bool
+        Search with jump point search (:mod:`pathfuse.search.jps`: the same
+        optimal costs without corner cutting, fewer expansions; no clearance
+        cost) instead of A*.
     """
     if heuristic not in HEURISTICS:
         raise ConfigError(f"heuristic: must be one of {', '.join(map(repr, HEURISTICS))}, "
@@ -173,10 +185,14 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
     else:
         sc, gc = problem.start_cell, problem.goal_cell
     budget = problem.budget
-    if problem.inflation_m > 0:
+    if problem.inflation_m > 0 and not jps:
         return _plan_with_margin(problem, occ, sc, gc, heuristic, corner_cutting,
                                  max_expansions)
-    if occupied is None:
+    if jps:
+        from pathfuse.search.jps import JPSSearcher, get_jps_searcher
+
+        searcher: Any = get_jps_searcher(cs) if occupied is None else JPSSearcher(occ)
+    elif occupied is None:
         searcher = get_searcher(cs, corner_cutting=corner_cutting)
     else:
         searcher = AStarSearcher(occ, corner_cutting=corner_cutting)

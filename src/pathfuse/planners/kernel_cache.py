@@ -22,13 +22,18 @@ def is_cached(dispatcher: Any) -> bool:
     return os.path.exists(index)
 
 
-def cold_kernels(spec: Any) -> list[str]:
-    """Names of the kernels ``spec`` (a PlannerSpec) runs that numba must still compile."""
+def cold_kernels(spec: Any, params: Any = None, diff_drive: bool = False) -> list[str]:
+    """Names of the kernels ``spec`` (a PlannerSpec) runs with ``params`` (its global
+    planner's and its controller's, with ``diff_drive`` those of a diff-drive robot too)
+    that numba must still compile."""
     kernels: list[Any] = []
-    if spec.uses_astar:
-        from pathfuse.search.kernel import _astar_kernel
+    gname = spec.global_planner_of(params)
+    if gname is not None:
+        from pathfuse.planners.global_planners import global_kernels
 
-        kernels.append(_astar_kernel)
+        kernels.extend(global_kernels(gname))
     if spec.controller is not None:
         kernels.extend(spec.controller.kernels())
+        if diff_drive:
+            kernels.extend(spec.controller.diff_drive_kernels())
     return [getattr(k, "__name__", str(k)) for k in kernels if not is_cached(k)]

@@ -21,8 +21,8 @@ from pathfuse.result import ConfigError
 from pathfuse.search.astar import HEURISTICS
 from pathfuse.validate import ParamSpec, check_fields, param
 
-__all__ = ["Checked", "GlobalAStarParams", "FieldParams", "DiscParams", "PursuitParams",
-           "BOUNDS"]
+__all__ = ["Checked", "GlobalChoice", "GlobalAStarParams", "FieldParams", "DiscParams",
+           "PursuitParams", "BOUNDS"]
 
 _BIG = 1e6  # gains, weights and costs
 BOUNDS: dict[str, tuple[float | None, float]] = {
@@ -97,6 +97,25 @@ class Checked:
 
     def __post_init__(self) -> None:
         check_fields(self)
+
+
+GLOBAL_PLANNER_HELP = ("the global planner whose path the controller follows (a name of "
+                       "'pathfuse planners': astar, jps, astar-smooth, thetastar, "
+                       "lazy-thetastar, shortest, or a plug-in's)")
+
+
+@dataclass(frozen=True)
+class GlobalChoice(Checked):
+    """The global planner a controller follows, by its registered name (the preset's own
+    by default; any registered one, plug-ins' included)."""
+
+    global_planner: str = param("astar", help=GLOBAL_PLANNER_HELP)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        from pathfuse.planners.registry import get_global_planner
+
+        get_global_planner(self.global_planner)  # names the choices when unknown
 
 
 @dataclass(frozen=True)

@@ -75,7 +75,7 @@ import numpy as np
 from pathfuse.field.forces import K_REP, RHO0_M, repulsive_force, repulsive_potential
 from pathfuse.field.kernels import S_SUB
 from pathfuse.planners.apf import SubgoalController
-from pathfuse.planners.params import DiscParams, FieldParams, GlobalAStarParams
+from pathfuse.planners.params import DiscParams, FieldParams, GlobalAStarParams, GlobalChoice
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.validate import integer, number, param
 
@@ -92,7 +92,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class Ref6Params(GlobalAStarParams, DiscParams, FieldParams):
+class Ref6Params(GlobalAStarParams, DiscParams, FieldParams, GlobalChoice):
     """Parameters of reference method [6] (paper values for K_att, K_rep, rho_0)."""
 
     subgoal_tolerance_m: float | None = param(
@@ -107,7 +107,7 @@ class Ref6Params(GlobalAStarParams, DiscParams, FieldParams):
 
 
 @dataclass(frozen=True)
-class Ref7Params(GlobalAStarParams, DiscParams, FieldParams):
+class Ref7Params(GlobalAStarParams, DiscParams, FieldParams, GlobalChoice):
     """Parameters of reference method [7] (paper values for K_att, K_rep, rho_0)."""
 
     segment_length_m: float = param(3.0, gt=0, unit="m",

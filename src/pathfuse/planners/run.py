@@ -21,49 +21,86 @@ from typing import Any
 import numpy as np
 
 from pathfuse.planners.base import Controller, Observed
-from pathfuse.planners.global_astar import GlobalPlan, plan_global
+from pathfuse.planners.global_astar import GlobalPlan
+from pathfuse.planners.global_planners import run_global
 from pathfuse.planners.registry import PlannerSpec
 from pathfuse.problem import Problem
 from pathfuse.result import PlanResult, Status, path_length
 
-__all__ = ["solve", "start_online", "warm", "Stopped", "PlanInfo"]
+__all__ = ["solve", "start_online", "warm", "warm_query", "Stopped", "PlanInfo"]
 
-_WARM: set[str] = set()
+_WARM: set[tuple[str, str | None, bool]] = set()
+_WARM_SEGMENT: list[bool] = []
 
 
-def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None) -> None:
+def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params: Any = None,
+         diff_drive: bool = False, segments: bool = True) -> None:
     """Compile (or load from numba's cache) the kernels ``spec`` runs, once per process.
 
-    ``notify`` is called first when the kernels are not in numba's on-disk
-    cache yet (the command line prints a one-line notice with it).
+    Only what runs is compiled: the global planner that ``params`` name (the
+    preset's by default), the controller's kernels, and with ``diff_drive``
+    those it runs online on a diff-drive robot only.  ``segments`` adds the
+    exact segment check the waypoints and the robot disc's end-point check
+    use (a point robot's ``astar`` plan needs neither).  ``notify`` is called
+    first when the kernels are not in numba's on-disk cache yet (the command
+    line prints a one-line notice with it).
     """
-    if spec.name in _WARM:
+    gname = spec.global_planner_of(params)
+    key = (spec.name, gname, diff_drive)
+    if key in _WARM:
+        if segments and not _WARM_SEGMENT:
+            _warm_segments()
         return
     from pathfuse.planners.kernel_cache import cold_kernels
 
-    if notify is not None and cold_kernels(spec):
+    if notify is not None and cold_kernels(spec, params=params, diff_drive=diff_drive):
         notify()
-    if not _WARM:  # the robot-disc check of a query's end points (Problem.failure)
-        from pathfuse.geometry import segment_is_clear
+    if segments and not _WARM_SEGMENT:
+        _warm_segments()
+    if gname is not None:
+        from pathfuse.planners.global_planners import warm_global
 
-        occ = np.zeros((2, 2), dtype=bool)
-        occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
-        segment_is_clear(0.5, 0.5, 0.5, 0.5, occ, 0.0, 0.0, 1.0, 0.1)
-    if spec.uses_astar:
-        from pathfuse.search.astar import warmup as astar_warmup
-
-        astar_warmup()
+        warm_global(gname)
     if spec.controller is not None:
         spec.controller.warmup()
-    _WARM.add(spec.name)
+        if diff_drive:
+            spec.controller.warmup_diff_drive()
+    _WARM.add(key)
+
+
+def warm_query(spec: PlannerSpec, params: Any, robot_radius_m: float,
+               notify: Callable[[], None] | None = None) -> None:
+    """:func:`warm` for one offline plan of ``spec`` (what :func:`solve` warms)."""
+    warm(spec, notify, params=params, segments=_needs_segments(spec, robot_radius_m))
+
+
+def _needs_segments(spec: PlannerSpec, robot_radius_m: float) -> bool:
+    """Whether an offline plan runs the exact segment check: a disc robot's end points
+    and snapping, or a controller that follows waypoints (a point robot's path follower
+    returns the global path as planned)."""
+    ctrl = spec.controller
+    return robot_radius_m > 0 or ctrl is None or not ctrl.search_budget
+
+
+def _warm_segments() -> None:
+    """The robot-disc check of a query's end points (Problem.failure) and of waypoints."""
+    from pathfuse.geometry import segment_is_clear
+
+    occ = np.zeros((2, 2), dtype=bool)
+    occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
+    segment_is_clear(0.5, 0.5, 0.5, 0.5, occ, 0.0, 0.0, 1.0, 0.1)
+    _WARM_SEGMENT.append(True)
 
 
 def _astar_info(gp: GlobalPlan | None) -> dict[str, Any]:
     if gp is None:
         return {}
-    return {"astar_path": np.asarray(gp.points, dtype=np.float64).reshape(-1, 2),
-            "astar_length": float(gp.length_m) if gp.success else 0.0,
-            "astar_time_s": float(gp.time_s)}
+    out = {"astar_path": np.asarray(gp.points, dtype=np.float64).reshape(-1, 2),
+           "astar_length": float(gp.length_m) if gp.success else 0.0,
+           "astar_time_s": float(gp.time_s)}
+    if gp.planner != "astar":  # the global path of another global planner, under A*'s keys
+        out["global_planner"] = gp.planner
+    return out
 
 
 def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
@@ -71,7 +108,7 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     bad = problem.failure()
     if bad is not None:
         return PlanResult(bad[0], planner=spec.name, message=bad[1])
-    warm(spec)
+    warm(spec, params=params, segments=_needs_segments(spec, problem.robot_radius_m))
     budget = problem.budget
     if spec.function is not None:
         res = spec.function(problem.grid, np.array(problem.start), np.array(problem.goal),
@@ -85,11 +122,13 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     deadline = (time.perf_counter() + budget.time_limit_s
                 if budget.time_limit_s is not None else None)
     gp = None
-    if spec.global_planner is not None:
-        gp = _global(spec, problem, params,
-                     budget.max_iterations if ctrl_cls.search_budget else None)
+    gname = spec.global_planner_of(params)
+    if gname is not None:
+        gp = run_global(gname, problem, params,
+                        budget.max_iterations if ctrl_cls.search_budget else None)
         if not gp.success:
-            msg = gp.message if ctrl_cls.search_budget else f"A* failed: {gp.message}"
+            what = "A*" if gname == "astar" else gname
+            msg = gp.message if ctrl_cls.search_budget else f"{what} failed: {gp.message}"
             return PlanResult(gp.status, time_s=gp.time_s, planner=spec.name,
                               expansions=gp.expansions, message=msg, info=_astar_info(gp))
     out = ctrl_cls(problem, params, gp).run(deadline)
@@ -99,18 +138,6 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     length = out.length_m if out.length_m is not None else path_length(out.path)
     return PlanResult(out.status, out.path, length, (gp.time_s if gp else 0.0) + out.time_s,
                       spec.name, gp.expansions if gp else 0, out.steps, out.message, info)
-
-
-def _global(spec: PlannerSpec, problem: Problem, params: Any,
-            max_expansions: int | None = None) -> GlobalPlan:
-    """The global plan of ``spec``: grid A*, or an any-angle planner."""
-    if spec.uses_astar:
-        return plan_global(problem, params.heuristic,
-                           bool(getattr(params, "corner_cutting", False)),
-                           max_expansions=max_expansions)
-    from pathfuse.planners.anyangle import plan_any_angle
-
-    return plan_any_angle(str(spec.global_planner), problem, params, max_expansions)
 
 
 class PlanInfo(dict):
@@ -168,12 +195,14 @@ def start_online(spec: PlannerSpec, problem: Problem, params: Any, dt: float,
 
         raise ConfigError(f"planner {spec.name!r} only plans offline (a plug-in function); "
                           "it cannot be simulated")
-    warm(spec)
+    rb = problem.robot
+    warm(spec, params=params, diff_drive=rb is not None and rb.is_diff_drive)
     gp = None
-    if spec.global_planner is not None:
-        gp = _global(spec, problem, params)
+    gname = spec.global_planner_of(params)
+    if gname is not None:
+        gp = run_global(gname, problem, params)
         if not gp.success:
-            what = "A*" if spec.uses_astar else spec.global_planner
+            what = "A*" if gname == "astar" else gname
             return Stopped(problem, params, gp.status,
                            f"{what} found no path for the robot on the static map: {gp.message}")
     return spec.controller(problem, params, gp, dt=dt, max_speed=max_speed)

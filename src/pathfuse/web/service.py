@@ -7,7 +7,6 @@ the command line; :mod:`pathfuse.web.app` turns it into a 4xx answer.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -75,48 +74,26 @@ def parse_body(raw: bytes, max_depth: int = 32) -> Any:
 def planners_json() -> list[dict[str, Any]]:
     """Every registered planner with its parameters' metadata, for generated forms.
 
-    One entry per planner of :func:`pathfuse.planner_names`, in its order:
-    ``name``, ``description``, ``offline``, ``online``, ``global_planner``,
-    ``layers`` (which of :data:`LAYERS` apply) and ``params``: name, default,
-    kind (``float``, ``int``, ``bool``, ``choice``, ``str``), unit, help, the
-    bounds ``gt``/``ge``/``le``, ``choices``, ``optional`` and ``accepts``
-    (the constraint in words, as ``pathfuse planners --params`` prints it).
+    One entry per planner of :func:`pathfuse.planner_names`, in its order: the
+    registry's :func:`~pathfuse.planners.registry.catalogue` entry (``description``,
+    ``offline``, ``online``, ``global_planner``, ``controller``, ``aliases``,
+    ``params``: name, default, kind (``float``, ``int``, ``bool``, ``choice``,
+    ``str``), unit, help, the bounds ``gt``/``ge``/``le``, ``choices``,
+    ``optional`` and ``accepts``) with its ``name`` and ``layers`` (which of
+    :data:`LAYERS` apply).
     """
-    from pathfuse.planners.registry import REGISTRY, planner_names
-    from pathfuse.validate import param_spec
+    from pathfuse.planners.registry import REGISTRY, catalogue
 
     out = []
-    for name in planner_names():
+    for name, d in catalogue()["planners"].items():
         spec = REGISTRY[name]
-        defaults = spec.params_cls()
-        params = []
-        names = set()
-        for f in dataclasses.fields(spec.params_cls):
-            ps = param_spec(f)
-            names.add(f.name)
-            d = getattr(defaults, f.name)
-            params.append({
-                "name": f.name,
-                "default": d if d is None or isinstance(d, (bool, int, float, str)) else str(d),
-                "kind": ps.kind if ps else ("float" if isinstance(d, float) else "str"),
-                "unit": ps.unit if ps else "",
-                "help": ps.help if ps else "",
-                "gt": ps.gt if ps else None, "ge": ps.ge if ps else None,
-                "le": ps.le if ps else None,
-                "choices": list(ps.choices) if ps else [],
-                "optional": bool(ps.optional) if ps else d is None,
-                "accepts": ps.describe() if ps else "",
-            })
+        names = {q["name"] for q in d["params"]}
         layers = []
         if spec.uses_astar:
             layers.append("closed")
         if spec.uses_astar and "r1_m" in names:
             layers.append("attractors")
-        out.append({
-            "name": name, "description": spec.description, "offline": spec.offline,
-            "online": spec.online, "global_planner": spec.global_planner,
-            "aliases": list(spec.aliases), "layers": layers, "params": params,
-        })
+        out.append({"name": name, **d, "layers": layers})
     return out
 
 
@@ -180,9 +157,7 @@ def plan_request(store: MapStore, body: Any, limits: Limits) -> dict[str, Any]:
     base64 int32 row-major indices; ``cspace``: the inflated
     map; ``attractors``: per path point, the A* waypoints attracting there).
     """
-    from pathfuse.planners.registry import get_planner, make_params
-    from pathfuse.planners.run import solve
-    from pathfuse.problem import Problem
+    from pathfuse.api import plan_query
 
     body = _keys(body, _PLAN_KEYS)
     grid, _ = _grid(store, body)
@@ -197,14 +172,15 @@ def plan_request(store: MapStore, body: Any, limits: Limits) -> dict[str, Any]:
                           f"{validate.short(layers)}")
     extras = validate.flag(body.get("extras", False), "extras") or bool(layers)
     limit = _time_limit(body, limits)
-    # what pathfuse.plan() does, with the parameters as a dict (no clash with its keywords)
-    spec = get_planner(planner)
-    cfg = make_params(spec, params)
-    problem = Problem.create(grid, start, goal, radius, Budget(time_limit_s=limit))
-    result = solve(spec, problem, cfg)
+    # pathfuse.plan()'s body, with the parameters as a dict (no clash with its keywords)
+    result, spec, cfg, problem = plan_query(grid, start, goal, planner, params,
+                                            robot_radius_m=radius,
+                                            budget=Budget(time_limit_s=limit))
+    on_astar = spec.global_planner_of(cfg) == "astar"
     d = result.to_dict()
     d["map"] = grid.name
     d["start"], d["goal"] = list(start), list(goal)
+    d["global_planner"] = spec.global_planner_of(cfg)
     if not extras:
         return d
     from pathfuse.metrics import evaluate
@@ -221,7 +197,7 @@ def plan_request(store: MapStore, body: Any, limits: Limits) -> dict[str, Any]:
         ex["astar_path"] = np.asarray(ap, dtype=float).tolist()
     heuristic = getattr(cfg, "heuristic", "euclidean")
     cutting = bool(getattr(cfg, "corner_cutting", False))
-    if "closed" in layers and spec.uses_astar:
+    if "closed" in layers and on_astar:
         from pathfuse.web.layers import closed_order, i32
 
         got = closed_order(problem, heuristic, cutting, limit)
@@ -232,7 +208,7 @@ def plan_request(store: MapStore, body: Any, limits: Limits) -> dict[str, Any]:
         ex["cspace"] = {"bits": pack_mask(grid.cspace(radius).occupied),
                         "robot_radius": radius}
     r1 = getattr(cfg, "r1_m", None)
-    if "attractors" in layers and spec.uses_astar and r1 is not None and len(result.path):
+    if "attractors" in layers and on_astar and r1 is not None and len(result.path):
         from pathfuse.planners.global_astar import plan_global
         from pathfuse.web.layers import attractors
 

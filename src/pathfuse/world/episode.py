@@ -259,9 +259,9 @@ def _params_of(spec: Any, params: Any) -> Any:
     return make_params(spec, params)
 
 
-def _warm(spec: Any, model: RobotModel) -> None:
+def _warm(spec: Any, model: RobotModel, cfg: Any) -> None:
     """Compile (or load) the kernels an episode runs, so that none compiles on a tick."""
-    warm(spec)
+    warm(spec, params=cfg, diff_drive=model.is_diff_drive)
     from pathfuse.shield import warmup_shield
 
     warmup_shield()  # the world's clip and the shield
@@ -330,7 +330,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
 
     problem = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius,
                              clearance_m=model.clearance_m, robot=model)
-    _warm(spec, model)
+    _warm(spec, model, cfg)
     t0 = time.perf_counter()
     ctrl: Controller = start_online(spec, problem, cfg, float(sc.dt), float(sc.robot.max_speed))
     setup = time.perf_counter() - t0
@@ -475,7 +475,7 @@ def _robot_spec(robot: Any) -> RobotSpec:
 
 
 def simulate(scenario: Any, planner: Any = None, seed: int | None = None,
-             robot: Any = None) -> Episode:
+             robot: Any = None, global_planner: str | None = None) -> Episode:
     """Simulate one episode of a dynamic scenario.
 
     Parameters
@@ -493,6 +493,10 @@ def simulate(scenario: Any, planner: Any = None, seed: int | None = None,
     robot : RobotModel or mapping, optional
         The robot to drive instead of the scenario's (a
         :class:`pathfuse.robot.RobotModel`, or a ``robot:`` block as a dict).
+    global_planner : str, optional
+        The global planner whose path the planner's controller follows (a name
+        of :func:`pathfuse.global_planner_names`; the parameter
+        ``global_planner``), instead of the planner's own.
 
     Returns
     -------
@@ -510,7 +514,12 @@ def simulate(scenario: Any, planner: Any = None, seed: int | None = None,
     >>> ep = simulate(sc, planner="astar")
     >>> ep.status.name, ep.n_ticks, round(ep.path_length_m, 6)
     ('SUCCESS', 68, 6.8)
+    >>> simulate(sc, planner="fusion", global_planner="thetastar").status.name
+    'SUCCESS'
     """
     sc = load_scenario(scenario)
     choice = resolve_planner_choice(sc.planner if planner is None else planner)
-    return run_episode(sc, choice.name, dict(choice.params), seed=seed, robot=robot)
+    params = dict(choice.params)
+    if global_planner is not None:
+        params["global_planner"] = global_planner
+    return run_episode(sc, choice.name, params, seed=seed, robot=robot)

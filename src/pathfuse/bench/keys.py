@@ -224,3 +224,23 @@ def _parse_limits(value: Any, where: str, base: Limits | None = None) -> Limits:
     return Limits(None if t is None else float(t), None if m is None else int(m))
 
 
+def check_generate(dyn: Mapping[str, Any], where: str) -> None:
+    """``{generate: {...}}`` holds arguments of ``generate_scenarios`` (pathfuse.world)."""
+    import inspect
+
+    from pathfuse.world.generate import generate_scenarios
+
+    if not set(dyn) <= {"generate", "family_seed"} or "generate" not in dyn \
+            or not isinstance(dyn["generate"], Mapping):
+        raise ConfigError(f"{where}: must be {{generate: {{moving: K, speed_range: [lo, hi], "
+                          f"...}}}} (and optionally family_seed: S), got {_short(dict(dyn))}")
+    fs = dyn.get("family_seed")
+    if fs is not None and (not _is_int(fs) or fs < 0):
+        raise ConfigError(f"{where}.family_seed: must be an integer >= 0, got {_short(fs)}")
+    allowed = [p for p in inspect.signature(generate_scenarios).parameters
+               if p not in ("n_scenarios", "seed", "first")]
+    for k in dyn["generate"]:
+        if k not in allowed:
+            raise ConfigError(f"{where}.generate.{k}: unknown argument (allowed:  "
+                              f"{', '.join(allowed)}; the run's seed is the family seed, "
+                              "or with family_seed the scenario's index)")

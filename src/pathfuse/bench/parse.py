@@ -29,6 +29,7 @@ from pathfuse.bench.keys import (
     _plain,
     _short,
     canonical_json,
+    check_generate,
     parse_seeds,
 )
 from pathfuse.bench.kind_irsim import external_names, external_spec, parse_irsim_entry
@@ -393,7 +394,7 @@ def _dynamic_entry(i: int, v: Mapping[str, Any], where: str, seeds: tuple[int, .
     elif isinstance(dyn, Mapping):
         dyn = _plain(dict(dyn))
         if "generate" in dyn:
-            _check_generate(dyn, f"{where}.dynamic")
+            check_generate(dyn, f"{where}.dynamic")
         default_name = f"dynamic-{i}"
     else:
         raise ConfigError(f"{where}.dynamic: must be a scenario file or a mapping, "
@@ -504,28 +505,6 @@ def _parse_map(i: int, v: Any, top_seeds: tuple[int, ...], top_radius: float,
                     seeds=seeds, robot_radius_m=radius, queries=tuple(queries),
                     random_queries=random_q, scen=scen, lines=v.get("lines"),
                     pair_keys="start" in v or "goal" in v)
-
-
-def _check_generate(dyn: Mapping[str, Any], where: str) -> None:
-    """``{generate: {...}}`` holds arguments of ``generate_scenarios`` (pathfuse.world)."""
-    import inspect
-
-    from pathfuse.world.generate import generate_scenarios
-
-    if not set(dyn) <= {"generate", "family_seed"} or "generate" not in dyn \
-            or not isinstance(dyn["generate"], Mapping):
-        raise ConfigError(f"{where}: must be {{generate: {{moving: K, speed_range: [lo, hi], "
-                          f"...}}}} (and optionally family_seed: S), got {_short(dict(dyn))}")
-    fs = dyn.get("family_seed")
-    if fs is not None and (not _is_int(fs) or fs < 0):
-        raise ConfigError(f"{where}.family_seed: must be an integer >= 0, got {_short(fs)}")
-    allowed = [p for p in inspect.signature(generate_scenarios).parameters
-               if p not in ("n_scenarios", "seed", "first")]
-    for k in dyn["generate"]:
-        if k not in allowed:
-            raise ConfigError(f"{where}.generate.{k}: unknown argument; expected one of "
-                              f"{', '.join(allowed)} (the run's seed is the family seed, "
-                              "or with family_seed the scenario's index)")
 
 
 def _entry_name(v: Mapping[str, Any], where: str, default: str) -> str:

@@ -3,13 +3,14 @@
 // default and help text.  Nothing here knows any planner by name.
 
 // One colour per planner, in the registry's order (astar, astar-replan, apf, fusion, ref6,
-// ref7, astar-smooth, thetastar, lazy-thetastar, shortest, dwa, mppi).  Chosen so that any two
+// ref7, astar-smooth, thetastar, lazy-thetastar, shortest, dwa, mppi, jps).  Chosen so that any two
 // differ by a CIEDE2000 distance of at least 12 for normal vision and for simulated
 // protanopia, deuteranopia and tritanopia (Machado et al. 2009, severity 1), with a contrast
 // of at least 2.2:1 on the white map; the browser test checks the colours the page shows.
-// A 13th planner (a plug-in) starts the colours again, drawn dashed.
+// (No chromatic 13th colour keeps that distance; black does.)  A 14th planner (a plug-in)
+// starts the colours again, drawn dashed.
 export const PALETTE = ["#00568F", "#74C200", "#33BBEE", "#DC1867", "#9B8427", "#8F0056",
-  "#5C5CFF", "#AE1313", "#27849B", "#777777", "#DE907C", "#0000F5"];
+  "#5C5CFF", "#AE1313", "#27849B", "#777777", "#DE907C", "#0000F5", "#000000"];
 
 function el(tag, attrs = {}, ...kids) {
   const e = document.createElement(tag);

@@ -644,7 +644,7 @@ def test_a_bad_port_is_one_line_and_exit_2(port):
                        capture_output=True, text=True, timeout=60)
     assert p.returncode == 2 and p.stdout == ""
     assert p.stderr.count("\n") == 1 and "Traceback" not in p.stderr
-    assert p.stderr.startswith("pathfuse serve: error: argument --port: expected a port")
+    assert p.stderr.startswith("pathfuse serve: error: argument --port: must be a port")
 
 
 def test_a_busy_port_is_one_line_and_no_banner():

@@ -72,7 +72,7 @@ def parse_irsim_entry(i: int, v: Mapping[str, Any], top_seeds: tuple[int, ...],
         w = {"world": w}
     if not isinstance(w, Mapping) or not isinstance(w.get("world"), str) \
             or set(w) - set(IRSIM_KEYS):
-        raise ConfigError(f"{where}.irsim: expected an IR-SIM world file or {{world: FILE, "
+        raise ConfigError(f"{where}.irsim: must be an IR-SIM world file or {{world: FILE, "
                           f"resolution_m: R, time_limit_s: T}}, got {_short(w)}")
     wp = Path(os.path.expanduser(w["world"]))
     wp = wp if wp.is_absolute() else exp_dir / wp

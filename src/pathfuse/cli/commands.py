@@ -415,7 +415,7 @@ def parse_seeds(text: str) -> int | str | list[int]:
             raise ValueError
         return n
     except ValueError:
-        raise CliError(f"--seeds: expected a count N >= 1, a range A:B with 0 <= A < B, "
+        raise CliError(f"--seeds: must be a count N >= 1, a range A:B with 0 <= A < B, "
                        f"or a list A,B,C of seeds >= 0, got {_shown(text)}") from None
 
 

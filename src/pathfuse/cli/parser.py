@@ -364,7 +364,7 @@ def _port(text: str) -> int:
     except ValueError:
         v = -1
     if not 0 <= v <= 65535:
-        raise argparse.ArgumentTypeError(f"expected a port from 0 to 65535 (0: any free "
+        raise argparse.ArgumentTypeError(f"must be a port from 0 to 65535 (0: any free "
                                          f"port), got {text[:40]!r}")
     return v
 

@@ -159,7 +159,7 @@ def read_world_spec(path: str | os.PathLike[str]) -> WorldSpec:
     block = {} if block is None else block
     where = f"{p}: custom.pathfuse"
     if not isinstance(block, Mapping):
-        raise ConfigError(f"{where}: expected a mapping, got {_shown(block)}")
+        raise ConfigError(f"{where}: must be a mapping, got {_shown(block)}")
     for k in block:
         if k not in WORLD_KEYS:
             raise ConfigError(f"{where}.{k}: unknown key (allowed: {', '.join(WORLD_KEYS)})")
@@ -167,7 +167,7 @@ def read_world_spec(path: str | os.PathLike[str]) -> WorldSpec:
               False)
     pert = block.get("perturb") or {}
     if not isinstance(pert, Mapping):
-        raise ConfigError(f"{where}.perturb: expected {{position_m, speed_frac}}, got "
+        raise ConfigError(f"{where}.perturb: must be {{position_m, speed_frac}}, got "
                           f"{_shown(pert)}")
     for k in pert:
         if k not in PERTURB_KEYS:
@@ -177,7 +177,7 @@ def read_world_spec(path: str | os.PathLike[str]) -> WorldSpec:
     spd = _num(pert.get("speed_frac", 0.0), f"{where}.perturb.speed_frac", 0.0, True, 0.9)
     for key in ("kind", "description"):
         if key in block and not isinstance(block[key], str):
-            raise ConfigError(f"{where}.{key}: expected a string, got {_shown(block[key])}")
+            raise ConfigError(f"{where}.{key}: must be a string, got {_shown(block[key])}")
     return WorldSpec(str(p), p.stem, str(block.get("kind", p.stem)),
                      str(block.get("description", "")), tl, pos, spd)
 

@@ -107,7 +107,7 @@ class IrsimConfig:
         from pathfuse.planners.registry import REGISTRY, get_planner, make_params, planner_names
 
         if isinstance(self.worlds, str) or not self.worlds:
-            raise ConfigError(f"worlds: expected a list of IR-SIM world files, got "
+            raise ConfigError(f"worlds: must be a list of IR-SIM world files, got "
                               f"{_shown(self.worlds)}")
         worlds = find_world_files(self.worlds)
         for w in worlds:
@@ -120,7 +120,7 @@ class IrsimConfig:
                               "identifies a world in the tables)")
         n = self.n_seeds
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-            raise ConfigError(f"n_seeds: expected a positive integer, got {_shown(n)}")
+            raise ConfigError(f"n_seeds: must be a positive integer, got {_shown(n)}")
         r = self.resolution_m
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not math.isfinite(r) \
                 or r <= 0:
@@ -130,7 +130,7 @@ class IrsimConfig:
                               or not math.isfinite(t) or t <= 0):
             raise ConfigError(f"time_limit_s: must be a number > 0, got {_shown(t)}")
         if isinstance(self.planners, str):
-            raise ConfigError(f"planners: expected a list of names, got {_shown(self.planners)}")
+            raise ConfigError(f"planners: must be a list of names, got {_shown(self.planners)}")
         names = []
         for p in tuple(self.planners) or (*[p for p in planner_names() if REGISTRY[p].online],
                                            RVO_BASELINE):
@@ -147,7 +147,7 @@ class IrsimConfig:
             names.append(spec.name)
         object.__setattr__(self, "planners", tuple(dict.fromkeys(names)))
         if not isinstance(self.params, Mapping):
-            raise ConfigError(f"params: expected {{planner: {{key: value}}}}, got "
+            raise ConfigError(f"params: must be {{planner: {{key: value}}}}, got "
                               f"{_shown(self.params)}")
         for name, ps in self.params.items():
             if name not in self.planners:

@@ -405,7 +405,7 @@ def create_app(*, map_folders: list[tuple[str, Path]] | None = None, limits: Lim
         except ApiError as exc:
             return _error(exc.status, str(exc))
         if len(files) != 1:
-            return _error(400, f"upload: expected one scenario YAML file, got {len(files)}")
+            return _error(400, f"upload: must be one scenario YAML file, got {len(files)}")
         return await compute(request, arrival, "upload_scenario", files[0][0], files[0][1])
 
     async def scenarios(request: Request) -> Response:

@@ -113,7 +113,7 @@ def social_metrics(robot_positions: Any, people_positions: Any, people_radii: An
     """
     p = np.asarray(robot_positions, dtype=np.float64)
     if p.ndim != 2 or p.shape[1] != 2 or p.shape[0] < 1:
-        raise ValueError(f"robot_positions: expected a (T, 2) array with T >= 1, got shape "
+        raise ValueError(f"robot_positions: must be a (T, 2) array with T >= 1, got shape "
                          f"{p.shape}")
     t = p.shape[0]
     q = np.asarray(people_positions, dtype=np.float64)
@@ -121,14 +121,14 @@ def social_metrics(robot_positions: Any, people_positions: Any, people_radii: An
     if q.size == 0:
         q = np.zeros((t, 0, 2))
     if q.ndim != 3 or q.shape[0] != t or q.shape[2] != 2 or q.shape[1] != r.shape[0]:
-        raise ValueError(f"people_positions: expected shape ({t}, {r.shape[0]}, 2) for {t} "
+        raise ValueError(f"people_positions: must have shape ({t}, {r.shape[0]}, 2) for {t} "
                          f"ticks and {r.shape[0]} radii, got {q.shape}")
     step = np.hypot(*np.diff(p, axis=0).T) if t > 1 else np.zeros(0)
     length = float(step.sum())
     if headings is not None:
         h = np.asarray(headings, dtype=np.float64).reshape(-1)
         if h.shape[0] != t:
-            raise ValueError(f"headings: expected {t} values (one per tick), got {h.shape[0]}")
+            raise ValueError(f"headings: must have {t} values (one per tick), got {h.shape[0]}")
         turn = float(np.abs(_wrap(np.diff(h))).sum()) if t > 1 else 0.0
     else:
         d = np.diff(p, axis=0)

@@ -40,7 +40,13 @@ def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, 
              n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
              decay, holonomic, ox, oy, res, passive=True, w_align=0.0, near_s=0.0,
              w_keep=0.0, keep_m=0.3, w_social=0.0, personal_m=0.5, w_side=0.0):
-    """The settings array of :func:`dwa_choose`."""
+    """The settings array of :func:`dwa_choose`.
+
+    With a safety margin (``margin > 0``) the passing-side critic is off: holding a side
+    pressed the robot against a wall in ``examples/scenarios/corridor_oncoming.yaml``
+    (``tests/test_clearance.py``), which a margin forbids."""
+    if margin > 0.0:
+        w_side = 0.0
     f = np.zeros(N_D)
     vals = (dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
             n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,

@@ -121,7 +121,9 @@ def test_bench_migrates_the_file_in_place_keeping_every_value(tmp_path):
     exp.write_text(EXPERIMENT)
     planned = {r.key for r in load_experiment(exp).expand()}
     stored = set(rows)
-    assert len(planned & stored) >= 8  # at least the 8 static runs of the room
+    # at least the 6 static runs of the room by astar (two settings) and apf; the fusion's
+    # static runs are run again: the fusion gained parameters since (the social critics)
+    assert len(planned & stored) >= 6
     assert run_bench(exp, db, workers=1, progress=False).ran == len(planned - stored)
 
 

@@ -358,7 +358,7 @@ def _parse_planner(i: int, v: Any, top_limits: Limits,
         index=i, name=name, label=label.strip() if label else None, params=tuple(params),
         limits=_parse_limits(v.get("limits"), f"{where}.limits", top_limits),
         kinds=tuple(specs), fields_by_kind=fields_by_kind,
-        defaults_by_kind={k: _plain(sp.key_defaults(k)) for k, sp in specs.items()})
+        defaults_by_kind={k: _plain(sp.key_defaults()) for k, sp in specs.items()})
     for combo in entry.combinations():  # cross-parameter checks of the dataclass
         for kind, sp in specs.items():
             try:

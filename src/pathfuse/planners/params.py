@@ -22,7 +22,7 @@ from pathfuse.search.astar import HEURISTICS
 from pathfuse.validate import ParamSpec, check_fields, param
 
 __all__ = ["Checked", "GlobalChoice", "GlobalAStarParams", "FieldParams", "DiscParams",
-           "PursuitParams", "PersonalSpaceParams", "SocialParams", "SOCIAL_FIELDS", "BOUNDS"]
+           "PursuitParams", "PersonalSpaceParams", "SocialParams", "BOUNDS"]
 
 _BIG = 1e6  # gains, weights and costs
 BOUNDS: dict[str, tuple[float | None, float]] = {
@@ -213,9 +213,6 @@ class SocialParams(PersonalSpaceParams):
                                help="passing-side critic: the cost of passing a disc on the "
                                     "other side than committed")
 
-
-SOCIAL_FIELDS = ("social", "social_weight", "personal_m", "side_weight")
-"""The social parameters (no effect without moving discs)."""
 
 _DD = " (diff-drive robot online; no effect on a holonomic robot)"
 

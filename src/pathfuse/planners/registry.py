@@ -160,22 +160,14 @@ class PlannerSpec:
         """The default parameters as a dict."""
         return dataclasses.asdict(self.params_cls())
 
-    def key_defaults(self, kind: str = "dynamic") -> dict[str, Any]:
+    def key_defaults(self) -> dict[str, Any]:
         """:meth:`defaults` as a study's run keys hash them: ``global_planner`` is left out
         while it is the preset's own, so a run that does not choose another global
         planner keeps the key it had before the parameter existed (stored studies stay
-        valid); one that chooses another names it in its own parameters.  For the
-        ``static`` kind the social parameters are left out too: they act only among
-        moving discs, so a static run keeps its key (a dynamic run's key changes with
-        them, as its outcome may)."""
-        from pathfuse.planners.params import SOCIAL_FIELDS
-
+        valid); one that chooses another names it in its own parameters."""
         d = self.defaults()
         if d.get("global_planner", 0) == self.global_planner:
             del d["global_planner"]
-        if kind == "static":
-            for name in SOCIAL_FIELDS:
-                d.pop(name, None)
         return d
 
     def capabilities(self) -> tuple[str, ...]:

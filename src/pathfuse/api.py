@@ -70,11 +70,6 @@ def plan(
         World coordinates in metres.
     planner : str
         A name from :func:`pathfuse.planner_names` (``pathfuse planners``).
-    global_planner : str, optional
-        (A planner parameter.)  The global planner whose path the planner's
-        controller follows, a name of :func:`pathfuse.global_planner_names`
-        (plug-ins' included); default: the planner's own.  Every planner with
-        a global planner takes it (not ``apf``, ``astar-replan``, ``mppi``).
     robot_radius_m : float
         Radius of a disc robot (default 0: a point; with ``robot``, its
         radius).  The global planner searches the map with obstacles and the
@@ -92,7 +87,11 @@ def plan(
         Iteration and time caps; every planner also has finite defaults.
     **params
         Planner parameters (see ``pathfuse planners`` or each planner's
-        parameter dataclass).
+        parameter dataclass).  Among them ``global_planner``: the global
+        planner whose path the planner's controller follows, a name of
+        :func:`pathfuse.global_planner_names` (plug-ins' included); default:
+        the planner's own.  Every planner with a global planner takes it (not
+        ``apf``, ``astar-replan``, ``mppi``).
 
     Returns
     -------

@@ -522,6 +522,8 @@ def catalogue() -> dict[str, Any]:
     ``controllers`` each registered controller to its ``label`` and the
     ``planners`` (presets) that use it.
 
+    Examples
+    --------
     >>> c = catalogue()
     >>> c["planners"]["fusion"]["controller"], c["planners"]["fusion"]["global_planner"]
     ('fusion', 'astar')

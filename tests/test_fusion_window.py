@@ -85,3 +85,77 @@ def test_recovery_replans_from_where_the_robot_stands():
             break
     assert info["event"] == "reached"
     assert ctrl._window.recoveries >= 1
+
+
+def _head_on(speed=0.6):
+    """A disc walks head on along the robot's straight route in a 5 m wide hall."""
+    return {"map": {"rows": ["." * 15] * 5, "resolution": 1.0},
+            "start": [1.5, 2.5], "goal": [13.5, 2.5],
+            "robot": {"radius": 0.2, "max_speed": 1.0, "sensing_radius": 3.0, **DIFF},
+            "dt": 0.1, "time_limit": 40,
+            "obstacles": [{"position": [10.5, 2.5], "velocity": [-speed, 0.0],
+                           "radius": 0.3}]}
+
+
+def _drive(sc, seed=0, **params):
+    """Run the fusion tick by tick; per tick (disc sensed, in-place turns so far, MPPI
+    ticks so far), and the episode's end."""
+    from pathfuse.world.scenario import load_scenario
+
+    sc = load_scenario(sc)
+    ctrl = _controller(sc, **params)
+    world = World(sc)
+    obs = world.reset(seed)
+    ticks = []
+    info: dict = {}
+    for _ in range(world.n_steps):
+        sensed = len(obs.obstacles) > 0
+        obs, terminated, truncated, info = world.step(ctrl.command(obs))
+        ticks.append((sensed, ctrl._window.rotations, ctrl._window.sequenced))
+        if terminated or truncated:
+            break
+    return ctrl, ticks, info
+
+
+def test_among_discs_mppi_sequences_track_the_local_path_and_the_robot_never_spins():
+    """Ours: while a disc is sensed the fusion's local path is tracked by MPPI's sequences,
+    and the robot does not stand to turn on the spot (how it was walked into: its local
+    path swung as discs came near and it spun while they arrived).  The head-on disc is
+    passed with room to spare."""
+    ctrl, ticks, info = _drive(_head_on())
+    assert info["event"] == "reached"
+    among = [i for i, t in enumerate(ticks) if t[0]]
+    assert among, "the disc was never sensed"
+    for i in among:
+        before = ticks[i - 1] if i else (False, 0, 0)
+        assert ticks[i][1] == before[1]  # no turn on the spot on a tick with a disc
+        assert ticks[i][2] == before[2] + 1  # decided by the sequences
+    assert ticks[-1][2] == len(among)
+    ep = simulate(_head_on(), planner="fusion")
+    assert ep.status is Status.SUCCESS and ep.min_obstacle_distance_m >= 0.3
+
+
+def test_among_discs_the_window_can_be_kept():
+    ctrl, ticks, info = _drive(_head_on(), among_discs="window")
+    assert ticks[-1][2] == 0
+    assert info["event"] != "collision" or not info.get("at_fault", False)
+
+
+def test_the_global_path_is_replanned_around_a_sensed_disc():
+    """Ours (as dwa): while a disc is sensed, A* again from the robot every
+    replan_period_s with the disc's cells blocked; 0 switches it off."""
+    ep = simulate(_head_on(0.3), planner="fusion")
+    assert len(ep.path_updates) >= 2
+    tick, path = ep.path_updates[1]
+    disc = ep.obstacle_positions[tick][0]
+    radius = ep.obstacle_radii[0] + 0.2
+    assert np.hypot(path[:, 0] - disc[0], path[:, 1] - disc[1]).min() >= radius
+    off = simulate(_head_on(0.3), planner={"name": "fusion",
+                                            "params": {"replan_period_s": 0}})
+    assert len(off.path_updates) == 1
+
+
+def test_among_discs_the_same_seed_gives_the_same_episode():
+    a = simulate(_head_on(), planner={"name": "fusion", "params": {"seed": 3}})
+    b = simulate(_head_on(), planner={"name": "fusion", "params": {"seed": 3}})
+    assert np.array_equal(a.positions, b.positions)

@@ -96,6 +96,7 @@ from pathfuse.planners.dwa_kernel import (
 )
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, SocialParams
 from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.planners.replan import replan_around_discs
 from pathfuse.planners.social import PassingSides, disc_ids
 from pathfuse.problem import Problem
 from pathfuse.result import Status
@@ -218,57 +219,11 @@ class DWAController(Controller):
         self.k = 0
 
     def _replan(self, x: float, y: float) -> None:
-        from pathfuse.planners.global_astar import plan_global
-
-        pb = self.problem
-        if self.params.global_planner != "astar":
-            self._replan_with(self.params.global_planner, x, y)
-            return
-        occ = None
         dpos, _, drad = self._sensed
-        if drad.shape[0]:
-            # the sensed discs as blocked cells, as Nav2's obstacle layer puts what the
-            # sensors see into the global costmap
-            from pathfuse.planners.astar import _rasterise_discs
-
-            g = pb.grid
-            occ = g.cspace(pb.robot_radius_m).occupied.copy()
-            _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
-                             dpos, drad, float(pb.robot_radius_m))
-        gp = plan_global(pb.with_start((x, y)), self.params.heuristic, occupied=occ)
-        if not gp.success and occ is not None:  # boxed in by the discs: the static path
-            gp = plan_global(pb.with_start((x, y)), self.params.heuristic)
+        pts = replan_around_discs(self.problem, x, y, dpos, drad, self.params)
         self.replans += 1
-        if gp.success:
-            self._set_path(np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2))
-            self.global_path = self.pts
-
-    def _replan_with(self, name: str, x: float, y: float) -> None:
-        """Replan with the registered global planner ``name`` (not A*): on the map with the
-        sensed discs' cells blocked (a global planner sees a map, not discs), or, when
-        that leaves no path or boxes the robot in, on the static map."""
-        from pathfuse.planners.global_planners import run_global
-
-        pb = self.problem
-        here = pb.with_start((x, y))
-        dpos, _, drad = self._sensed
-        gp = None
-        if drad.shape[0]:
-            from pathfuse.planners.astar import _rasterise_discs
-
-            g = pb.grid
-            occ = g.occupied.copy()
-            _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
-                             dpos, drad, 0.0)
-            crowded = Problem.create(g.with_occupied(occ), (x, y), pb.goal, pb.robot_radius_m,
-                                     pb.budget, pb.clearance_m, pb.robot)
-            if crowded.failure() is None:
-                gp = run_global(name, crowded, self.params)
-        if gp is None or not gp.success:
-            gp = run_global(name, here, self.params)
-        self.replans += 1
-        if gp.success:
-            self._set_path(np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2))
+        if pts is not None:
+            self._set_path(pts)
             self.global_path = self.pts
 
     def relax(self, seconds: float) -> bool:

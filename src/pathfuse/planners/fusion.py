@@ -79,6 +79,7 @@ from pathfuse.field.kernels import (
     S_BACKOFF,
     S_ESCAPES,
     S_K,
+    S_MODE,
     S_REF,
     fusion_loop,
     pack_fusion,
@@ -95,6 +96,7 @@ from pathfuse.planners.params import (
     SocialParams,
 )
 from pathfuse.planners.registry import PlannerSpec, register
+from pathfuse.planners.replan import replan_around_discs
 from pathfuse.problem import Problem
 from pathfuse.validate import param
 
@@ -128,6 +130,18 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                                     "the paper as printed)")
     escape_points: int = param(3, ge=1, help="A* points to follow in an escape before "
                                              "Algorithm 2 resumes")
+    replan_period_s: float = param(
+        1.0, ge=0, le=3600, unit="s",
+        help="diff-drive robot online, velocity space, while a moving disc is sensed: plan "
+             "the global path again from the robot, around the sensed discs, this often "
+             "(ours, as dwa; 0 = never)")
+    among_discs: str = param(
+        "mppi", choices=("mppi", "window"),
+        help="diff-drive robot online, velocity space, while a moving disc is sensed: track "
+             "Algorithm 2's local path with MPPI's sampled control sequences (ours; they can "
+             "swerve and get away) or with the dynamic window as without discs")
+    seed: int = param(0, ge=0, le=2**63 - 1,
+                      help="seed of MPPI's sampling noise among discs (among_discs='mppi')")
     velocity_space: bool = param(True, help="diff-drive robot online: choose (v, omega) from "
                                             "the dynamic window by agreement with Algorithm "
                                             "2's move, clearance and the predicted discs "
@@ -181,7 +195,12 @@ class FusionController(FieldController):
             from pathfuse.planners.fusion_window import ForceWindow
 
             self._window = ForceWindow(problem, float(self.dt),  # type: ignore[arg-type]
-                                       social=p)
+                                       social=p, among_discs=p.among_discs, seed=p.seed)
+        self._ticks = 0
+        self.replans = 0
+        self._replan_every = 0
+        if self._window is not None and p.replan_period_s > 0:
+            self._replan_every = max(1, int(round(p.replan_period_s / self._window.f[0])))
 
     def command(self, obs: Any) -> np.ndarray:
         """On a diff-drive robot with ``velocity_space`` (ours): Algorithm 2's move for this
@@ -189,6 +208,7 @@ class FusionController(FieldController):
         shield; otherwise as every controller (:meth:`Controller.command`)."""
         if self._window is None:
             return super().command(obs)
+        self._replan_among_discs(obs)
         self.act(obs)  # Algorithm 2 keeps up with the robot, in a recovery too
         a = self._recovering(obs, self.problem.robot, force=True)
         if a is None:
@@ -197,6 +217,29 @@ class FusionController(FieldController):
         if not self.problem.robot.shield:  # type: ignore[union-attr]
             return a
         return self._shielded(obs, a)
+
+    def _replan_among_discs(self, obs: Any) -> None:
+        """Ours (velocity space): while a disc is sensed, the global path again from the
+        robot, around the discs, every ``replan_period_s`` (as ``dwa`` does; the A* points
+        that attract the robot then lead around them).  Not during an escape, whose target
+        indices refer to the path it started on."""
+        self._ticks += 1
+        dpos, _, drad = sensed_discs(obs)
+        if not (drad.shape[0] and self._replan_every and self._ticks % self._replan_every == 0
+                and int(self.state[S_MODE]) == 0):
+            return
+        pts = replan_around_discs(self.problem, float(obs.position[0]),
+                                  float(obs.position[1]), dpos, drad, self.params)
+        self.replans += 1
+        if pts is None:
+            return
+        gx, gy = self.problem.goal
+        if pts[-1, 0] != gx or pts[-1, 1] != gy:
+            pts = np.concatenate([pts, [[gx, gy]]])
+        self.pts = np.require(pts, dtype=np.float64, requirements=("C", "W"))
+        self.cum = polyline_cumlen(self.pts)
+        self.state[S_K] = 0  # the new path starts where the robot stands
+        self.global_path = self.pts
 
     def relax(self, seconds: float) -> bool:
         """Recovery (ours): the velocity-space window drops its obstacle critic for
@@ -264,8 +307,9 @@ class FusionController(FieldController):
     @classmethod
     def diff_drive_kernels(cls) -> Sequence[Any]:
         from pathfuse.planners.dwa_kernel import dwa_choose, route_tangent
+        from pathfuse.planners.mppi import MPPIController
 
-        return (dwa_choose, route_tangent)
+        return (dwa_choose, route_tangent, *MPPIController.kernels())
 
     @classmethod
     def warmup(cls) -> None:
@@ -280,7 +324,10 @@ class FusionController(FieldController):
     def warmup_diff_drive(cls) -> None:
         from pathfuse.planners.dwa import DWAController
 
+        from pathfuse.planners.mppi import MPPIController
+
         DWAController.warmup()  # the velocity-space fusion scores with dwa's window
+        MPPIController.warmup()  # and among discs with MPPI's sequences
 
 
 _WARM = [False]

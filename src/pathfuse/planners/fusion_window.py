@@ -89,14 +89,26 @@ class ForceWindow:
     social : SocialParams, optional
         The social critics among sensed moving discs (ours,
         :mod:`pathfuse.planners.social`; default: ``dwa``'s).
+    among_discs : {"mppi", "window"}
+        Who tracks the local path while a moving disc is sensed (ours): MPPI's
+        sampled sequences, or the dynamic window as without discs.
+    seed : int
+        Seed of MPPI's sampling noise.
     """
 
-    def __init__(self, problem: Any, dt: float, social: Any = None) -> None:
+    def __init__(self, problem: Any, dt: float, social: Any = None,
+                 among_discs: str = "mppi", seed: int = 0) -> None:
         from pathfuse.planners.dwa import DWAParams
 
         rb = problem.robot
         p = DWAParams()
         sp = p if social is None else social
+        self.social = sp
+        self.among_discs = among_discs
+        self.seed = int(seed)
+        self._mppi: Any = None
+        self.sequenced = 0
+        """Ticks decided by MPPI's sequences among discs."""
         g = problem.grid
         self.problem = problem
         self.horizon_s = float(p.horizon_s)
@@ -216,8 +228,13 @@ class ForceWindow:
         j = int(np.searchsorted(pcum, pcum[kk] + self.look_m))
         j = min(max(j, kk + 1), path.shape[0] - 1)
         err = _wrap(math.atan2(float(path[j, 1]) - y, float(path[j, 0]) - x) - th)
-        if abs(err) > self.rotate_rad:
+        # ours: not while a disc is sensed; standing to turn is how the fusion was walked
+        # into (the local path swung as discs came near and the robot spun on the spot)
+        among = drad.shape[0] > 0
+        if abs(err) > self.rotate_rad and not among:
             return self._rotate(err)
+        if self.among_discs == "mppi" and drad.shape[0] > 0:
+            return self._sequences(obs, path, kk, pts, k, dpos, dvel, drad)
         f = self.f_relaxed if self.ticks <= self.relaxed_until else self.f
         # the keep critic's reference: the gap the A* path keeps ahead (the local path is
         # the field's streamline, which may graze)
@@ -235,12 +252,43 @@ class ForceWindow:
         if n:
             self.sides.update(ids, chosen, dpos, (x, y), route, drad,
                               self.problem.robot_radius_m)
-        if a0 <= 0.0 and float(cmd[0]) <= 0.0 and abs(err) > 0.05:
+        if a0 <= 0.0 and float(cmd[0]) <= 0.0 and abs(err) > 0.05 and not among:
             # the window's best is to stand and turn: turn towards the local path at the rate
             # from which the turn stops there (the window's long constant-omega rollouts
             # would spin past it)
             return self._rotate(err)
         return np.array([float(a0), float(a1)])
+
+    def _sequences(self, obs: Any, path: np.ndarray, kk: int, pts: np.ndarray, k: int,
+                   dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray) -> np.ndarray:
+        """Among sensed discs (``among_discs="mppi"``, ours): the command of MPPI's sampled
+        control sequences (:mod:`pathfuse.planners.mppi`, its defaults and critics) tracking
+        Algorithm 2's local path from the robot, then the A* path beyond the point nearest
+        that path's end.  A sequence can swerve or get away after it has accelerated, which
+        the window's one command held over the horizon cannot."""
+        from pathfuse.planners.mppi import MPPIController, MPPIParams
+
+        if self._mppi is None:
+            class _Plan:
+                waypoints = pts
+
+            sp = self.social
+            mp = MPPIParams(seed=self.seed, social=sp.social, social_weight=sp.social_weight,
+                            personal_m=sp.personal_m)
+            self._mppi = MPPIController(self.problem, mp, _Plan(), dt=float(self.f[0]),
+                                        max_speed=self.vmax)
+            self._mppi.replan_every = 0  # the fusion replans (FusionController)
+        m = self._mppi
+        e = path[-1]
+        k0 = min(max(int(k), 0), pts.shape[0] - 1)
+        j = k0 + int(np.argmin(np.hypot(pts[k0:, 0] - e[0], pts[k0:, 1] - e[1])))
+        m._set_path(np.concatenate([path[kk:], pts[j + 1:]]))
+        m._sensed = (dpos, dvel, drad)
+        cmd = obs.command
+        self.sequenced += 1
+        a0, a1 = m._choose(float(obs.position[0]), float(obs.position[1]), float(obs.heading),
+                           float(cmd[0]), float(cmd[1]), dpos, dvel, drad)
+        return np.array([a0, a1])
 
     def _rotate(self, err: float) -> np.ndarray:
         rb = self.problem.robot

@@ -1,0 +1,89 @@
+"""The global path again from where the robot stands, around the sensed discs (ours).
+
+Nav2's obstacle layer puts what the sensors see into the global costmap and
+its default behaviour tree replans the global path once a second.
+:func:`replan_around_discs` does the same for pathfuse's controllers: the
+global planner runs from the robot's position on the map with the sensed
+discs' cells blocked (grown by the robot's radius for A*, which searches the
+c-space), and on the static map when the discs box the robot in.  ``dwa``
+replans so every ``replan_period_s``; the fusion in velocity space
+(:mod:`pathfuse.planners.fusion_window`) while it senses a disc.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from pathfuse.problem import Problem
+
+__all__ = ["replan_around_discs"]
+
+
+def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
+                        drad: np.ndarray, params: Any) -> np.ndarray | None:
+    """Waypoints ``(M, 2)`` of a new global path from ``(x, y)`` to the goal, or None.
+
+    Parameters
+    ----------
+    problem : Problem
+        The query (map, goal, robot).
+    x, y : float
+        Where the robot stands (metres).
+    dpos, drad : ndarray
+        The sensed discs' centres ``(K, 2)`` and radii ``(K,)`` (``K`` may be 0:
+        the static map).
+    params
+        The planner's parameters: ``global_planner`` names the global planner
+        (``"astar"`` searches with ``heuristic``).
+
+    Returns
+    -------
+    ndarray or None
+        None when no path is found (on the crowded map nor on the static one).
+    """
+    name = params.global_planner
+    if name != "astar":
+        return _with_registered(problem, name, x, y, dpos, drad, params)
+    from pathfuse.planners.global_astar import plan_global
+
+    occ = None
+    if drad.shape[0]:
+        from pathfuse.planners.astar import _rasterise_discs
+
+        g = problem.grid
+        occ = g.cspace(problem.robot_radius_m).occupied.copy()
+        _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
+                         dpos, drad, float(problem.robot_radius_m))
+    here = problem.with_start((x, y))
+    gp = plan_global(here, params.heuristic, occupied=occ)
+    if not gp.success and occ is not None:  # boxed in by the discs: the static path
+        gp = plan_global(here, params.heuristic)
+    return np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2) if gp.success else None
+
+
+def _with_registered(problem: Problem, name: str, x: float, y: float, dpos: np.ndarray,
+                     drad: np.ndarray, params: Any) -> np.ndarray | None:
+    """The registered global planner ``name`` (not A*): on the map with the sensed discs'
+    cells blocked (a global planner sees a map, not discs), or, when that leaves no path
+    or boxes the robot in, on the static map."""
+    from pathfuse.planners.global_planners import run_global
+
+    here = problem.with_start((x, y))
+    gp = None
+    if drad.shape[0]:
+        from pathfuse.planners.astar import _rasterise_discs
+
+        g = problem.grid
+        occ = g.occupied.copy()
+        _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
+                         dpos, drad, 0.0)
+        crowded = Problem.create(g.with_occupied(occ), (x, y), problem.goal,
+                                 problem.robot_radius_m, problem.budget, problem.clearance_m,
+                                 problem.robot)
+        if crowded.failure() is None:
+            gp = run_global(name, crowded, params)
+    if gp is None or not gp.success:
+        gp = run_global(name, here, params)
+    return np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2) if gp.success else None

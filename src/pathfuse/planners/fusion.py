@@ -323,7 +323,6 @@ class FusionController(FieldController):
     @classmethod
     def warmup_diff_drive(cls) -> None:
         from pathfuse.planners.dwa import DWAController
-
         from pathfuse.planners.mppi import MPPIController
 
         DWAController.warmup()  # the velocity-space fusion scores with dwa's window

@@ -24,7 +24,7 @@ import pathfuse.search.kernel as kernel_mod
 from pathfuse import Budget, ConfigError, GridMap, MapError, QueryError, Status
 from pathfuse.io.movingai import read_movingai
 from pathfuse.io.scenario import read_scen, scen_map_name
-from pathfuse.planners.astar import AStarParams, FollowController
+from pathfuse.planners.controllers.follow import AStarParams, FollowController
 from pathfuse.planners.params import PursuitParams
 from pathfuse.planners.registry import get_planner
 from pathfuse.planners.run import warm

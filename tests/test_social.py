@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from pathfuse.grid import GridMap
-from pathfuse.planners import dwa_kernel as K
-from pathfuse.planners.fusion_window import ForceWindow
+from pathfuse.planners.controllers import dwa_kernel as K
+from pathfuse.planners.controllers.fusion_window import ForceWindow
+from pathfuse.planners.controllers.social import COMMIT_M, PassingSides
 from pathfuse.planners.params import SocialParams
-from pathfuse.planners.social import COMMIT_M, PassingSides
 from pathfuse.problem import Problem
 from pathfuse.robot import RobotModel
 from pathfuse.sweep import disc_sweep_gaps

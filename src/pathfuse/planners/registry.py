@@ -433,8 +433,9 @@ def _load_builtin() -> None:
     _LOADED = True
     import importlib
 
-    for mod in ("global_planners", "astar", "apf", "fusion", "refs", "anyangle", "dwa",
-                "mppi"):
+    for mod in ("globals.builtin", "controllers.follow", "controllers.apf",
+                "controllers.fusion", "controllers.refs", "controllers.anyangle",
+                "controllers.dwa", "controllers.mppi"):
         importlib.import_module(f"pathfuse.planners.{mod}")
     try:
         load_plugins()

@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 
 from pathfuse.planners.base import Controller, Observed
-from pathfuse.planners.global_astar import GlobalPlan
-from pathfuse.planners.global_planners import run_global
+from pathfuse.planners.globals.astar import GlobalPlan
+from pathfuse.planners.globals.builtin import run_global
 from pathfuse.planners.registry import PlannerSpec
 from pathfuse.problem import Problem
 from pathfuse.result import PlanResult, Status, path_length
@@ -58,7 +58,7 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
     if segments and not _WARM_SEGMENT:
         _warm_segments()
     if gname is not None:
-        from pathfuse.planners.global_planners import warm_global
+        from pathfuse.planners.globals.builtin import warm_global
 
         warm_global(gname)
     if spec.controller is not None:

@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.geometry import MARGIN_FRAC
-from pathfuse.planners.global_astar import GlobalPlan, plan_global, snap_cell
+from pathfuse.planners.globals.astar import GlobalPlan, plan_global, snap_cell
 from pathfuse.planners.registry import (
     _BUILTIN_GLOBAL,
     PluginError,

@@ -178,7 +178,7 @@ class FusionController(FieldController):
         rb = problem.robot
         self._window: Any = None
         if self.online and rb is not None and rb.is_diff_drive and p.velocity_space:
-            from pathfuse.planners.fusion_window import ForceWindow
+            from pathfuse.planners.controllers.fusion_window import ForceWindow
 
             self._window = ForceWindow(problem, float(self.dt),  # type: ignore[arg-type]
                                        social=p)
@@ -263,7 +263,7 @@ class FusionController(FieldController):
 
     @classmethod
     def diff_drive_kernels(cls) -> Sequence[Any]:
-        from pathfuse.planners.dwa_kernel import dwa_choose, route_tangent
+        from pathfuse.planners.controllers.dwa_kernel import dwa_choose, route_tangent
 
         return (dwa_choose, route_tangent)
 
@@ -278,7 +278,7 @@ class FusionController(FieldController):
 
     @classmethod
     def warmup_diff_drive(cls) -> None:
-        from pathfuse.planners.dwa import DWAController
+        from pathfuse.planners.controllers.dwa import DWAController
 
         DWAController.warmup()  # the velocity-space fusion scores with dwa's window
 

@@ -86,7 +86,7 @@ import numpy as np
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
-from pathfuse.planners.dwa_kernel import (
+from pathfuse.planners.controllers.dwa_kernel import (
     dwa_choose,
     pack_dwa,
     relaxed,
@@ -94,9 +94,9 @@ from pathfuse.planners.dwa_kernel import (
     set_keep_reference,
     set_route,
 )
+from pathfuse.planners.controllers.social import PassingSides, disc_ids
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, SocialParams
 from pathfuse.planners.registry import PlannerSpec, register
-from pathfuse.planners.social import PassingSides, disc_ids
 from pathfuse.problem import Problem
 from pathfuse.result import Status
 from pathfuse.robot import RobotModel
@@ -218,7 +218,7 @@ class DWAController(Controller):
         self.k = 0
 
     def _replan(self, x: float, y: float) -> None:
-        from pathfuse.planners.global_astar import plan_global
+        from pathfuse.planners.globals.astar import plan_global
 
         pb = self.problem
         if self.params.global_planner != "astar":
@@ -229,7 +229,7 @@ class DWAController(Controller):
         if drad.shape[0]:
             # the sensed discs as blocked cells, as Nav2's obstacle layer puts what the
             # sensors see into the global costmap
-            from pathfuse.planners.astar import _rasterise_discs
+            from pathfuse.planners.controllers.follow import _rasterise_discs
 
             g = pb.grid
             occ = g.cspace(pb.robot_radius_m).occupied.copy()
@@ -247,14 +247,14 @@ class DWAController(Controller):
         """Replan with the registered global planner ``name`` (not A*): on the map with the
         sensed discs' cells blocked (a global planner sees a map, not discs), or, when
         that leaves no path or boxes the robot in, on the static map."""
-        from pathfuse.planners.global_planners import run_global
+        from pathfuse.planners.globals.builtin import run_global
 
         pb = self.problem
         here = pb.with_start((x, y))
         dpos, _, drad = self._sensed
         gp = None
         if drad.shape[0]:
-            from pathfuse.planners.astar import _rasterise_discs
+            from pathfuse.planners.controllers.follow import _rasterise_discs
 
             g = pb.grid
             occ = g.occupied.copy()

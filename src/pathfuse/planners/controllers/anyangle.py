@@ -51,9 +51,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from pathfuse.planners.astar import FollowController
-from pathfuse.planners.global_astar import GlobalPlan
-from pathfuse.planners.global_planners import PathPlan, run_global
+from pathfuse.planners.controllers.follow import FollowController
+from pathfuse.planners.globals.astar import GlobalPlan
+from pathfuse.planners.globals.builtin import PathPlan, run_global
 from pathfuse.planners.params import (
     GLOBAL_PLANNER_HELP,
     GlobalAStarParams,

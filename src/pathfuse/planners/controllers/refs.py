@@ -74,7 +74,7 @@ import numpy as np
 
 from pathfuse.field.forces import K_REP, RHO0_M, repulsive_force, repulsive_potential
 from pathfuse.field.kernels import S_SUB
-from pathfuse.planners.apf import SubgoalController
+from pathfuse.planners.controllers.apf import SubgoalController
 from pathfuse.planners.params import DiscParams, FieldParams, GlobalAStarParams, GlobalChoice
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.validate import integer, number, param

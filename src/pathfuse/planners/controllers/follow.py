@@ -52,7 +52,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.planners.base import Controller, Observed, Outcome
-from pathfuse.planners.global_astar import plan_global
+from pathfuse.planners.globals.astar import plan_global
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, PursuitParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -137,7 +137,7 @@ class FollowController(Controller):
         self._rpp: Any = None
         rb = problem.robot
         if self.online and rb is not None and rb.is_diff_drive:
-            from pathfuse.planners.rpp import RegulatedPurePursuit
+            from pathfuse.planners.controllers.rpp import RegulatedPurePursuit
 
             dt, top = float(self.dt), float(self.max_speed)  # type: ignore[arg-type]
             self._rpp = RegulatedPurePursuit(problem, params, dt, top)
@@ -175,13 +175,13 @@ class FollowController(Controller):
 
     @classmethod
     def diff_drive_kernels(cls) -> Sequence[Any]:
-        from pathfuse.planners.rpp import rpp_step
+        from pathfuse.planners.controllers.rpp import rpp_step
 
         return (rpp_step,)
 
     @classmethod
     def warmup_diff_drive(cls) -> None:
-        from pathfuse.planners.rpp import warmup_rpp
+        from pathfuse.planners.controllers.rpp import warmup_rpp
 
         warmup_rpp()
 

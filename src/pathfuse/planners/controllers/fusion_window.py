@@ -52,7 +52,7 @@ import numpy as np
 from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.base import sensed_discs
-from pathfuse.planners.dwa_kernel import (
+from pathfuse.planners.controllers.dwa_kernel import (
     dwa_choose,
     dwa_progress,
     pack_dwa,
@@ -61,7 +61,7 @@ from pathfuse.planners.dwa_kernel import (
     set_keep_reference,
     set_route,
 )
-from pathfuse.planners.social import PassingSides, disc_ids
+from pathfuse.planners.controllers.social import PassingSides, disc_ids
 
 __all__ = ["ForceWindow", "PASSIVE_WINDOW"]
 
@@ -92,7 +92,7 @@ class ForceWindow:
     """
 
     def __init__(self, problem: Any, dt: float, social: Any = None) -> None:
-        from pathfuse.planners.dwa import DWAParams
+        from pathfuse.planners.controllers.dwa import DWAParams
 
         rb = problem.robot
         p = DWAParams()
@@ -150,7 +150,7 @@ class ForceWindow:
         self.relax_replan = True
 
     def _replan(self, x: float, y: float) -> None:
-        from pathfuse.planners.global_astar import plan_global
+        from pathfuse.planners.globals.astar import plan_global
 
         pb = self.problem
         gp = plan_global(pb.with_start((x, y)), "euclidean")

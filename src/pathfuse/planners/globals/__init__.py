@@ -1,0 +1,1 @@
+"""The global planners: a problem in, a path of waypoints in metres out."""

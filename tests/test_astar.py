@@ -359,7 +359,7 @@ def test_registry_entry():
     assert spec.params_cls is AStarParams and spec.global_planner == "astar"
     assert spec.uses_astar and spec.offline and spec.online and spec.description
     # the global planner it follows, the search's parameters, then the diff-drive path
-    # follower's (planners/rpp.py)
+    # follower's (planners/controllers/rpp.py)
     assert spec.defaults() == {"global_planner": "astar", "heuristic": "euclidean",
                                "corner_cutting": False, **dataclasses.asdict(PursuitParams())}
     warm(spec)

@@ -1,4 +1,4 @@
-"""Regulated Pure Pursuit (pathfuse.planners.rpp), the path followers' controller on a
+"""Regulated Pure Pursuit (pathfuse.planners.controllers.rpp), the path followers' controller on a
 diff-drive robot: its geometry, episodes along corridors and on a BARN world, and the
 holonomic walk left exactly as it was."""
 

@@ -1,5 +1,6 @@
-"""Social behaviour among moving discs (ours; pathfuse.planners.social): personal space over
-the predicted gaps and a committed passing side, in dwa, the fusion's window and mppi."""
+"""Social behaviour among moving discs (ours; pathfuse.planners.controllers.social):
+personal space over the predicted gaps and a committed passing side, in dwa, the fusion's
+window and mppi."""
 
 from __future__ import annotations
 

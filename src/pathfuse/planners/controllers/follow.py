@@ -2,7 +2,7 @@
 
 ``astar``
     Exact 8-connected grid A* between cell centres
-    (:mod:`pathfuse.planners.global_astar`).  Offline, :func:`pathfuse.plan`
+    (:mod:`pathfuse.planners.globals.astar`).  Offline, :func:`pathfuse.plan`
     returns the A* path through the cell centres from the start cell to the
     goal cell; its length is the A* cost (a straight move is one cell side,
     a diagonal ``sqrt(2)`` sides, times the resolution), and
@@ -10,7 +10,7 @@
     :func:`pathfuse.simulate` walks the path (start, centres, goal) at full
     speed, blind to moving discs: the paper's "A* cannot handle dynamic
     obstacles", made measurable.  On a diff-drive robot it follows the path
-    with Regulated Pure Pursuit (:mod:`pathfuse.planners.rpp`, Nav2's
+    with Regulated Pure Pursuit (:mod:`pathfuse.planners.controllers.rpp`, Nav2's
     follower), still blind to moving discs.  ``astar-follow`` is an older
     name of it.
 ``astar-replan``
@@ -109,10 +109,10 @@ def _cumlen(path: np.ndarray) -> np.ndarray:
 
 class FollowController(Controller):
     """Walk the global path at full speed (offline: return it as planned); on a diff-drive
-    robot, follow it with Regulated Pure Pursuit (:mod:`pathfuse.planners.rpp`).
+    robot, follow it with Regulated Pure Pursuit (:mod:`pathfuse.planners.controllers.rpp`).
 
     It follows the path of any global planner.  A taut path (an any-angle one, or a
-    plug-in's: :attr:`GlobalPlan.taut <pathfuse.planners.global_astar.GlobalPlan.taut>`)
+    plug-in's: :attr:`GlobalPlan.taut <pathfuse.planners.globals.astar.GlobalPlan.taut>`)
     turns where it touches the robot's clearance around an obstacle corner, so a move
     across a corner would come closer than the radius: a holonomic robot's walk then ends
     a tick's move on the next corner (at most one tick per corner, and these paths have

@@ -1,7 +1,7 @@
 """The A*-APF fusion planner (paper Section III.C, Algorithm 2), registered as ``"fusion"``.
 
 Step 1 plans a global path with grid A*
-(:mod:`pathfuse.planners.global_astar`), or with the global planner that the
+(:mod:`pathfuse.planners.globals.astar`), or with the global planner that the
 parameter ``global_planner`` names (ours: any registered one, a plug-in's
 too); if it fails its status is returned.
 Step 2 starts the robot at ``start`` and repeats, until the goal is reached:
@@ -185,7 +185,7 @@ class FusionController(FieldController):
 
     def command(self, obs: Any) -> np.ndarray:
         """On a diff-drive robot with ``velocity_space`` (ours): Algorithm 2's move for this
-        tick scored in velocity space (:mod:`pathfuse.planners.fusion_window`), then the
+        tick scored in velocity space (:mod:`pathfuse.planners.controllers.fusion_window`), then the
         shield; otherwise as every controller (:meth:`Controller.command`)."""
         if self._window is None:
             return super().command(obs)
@@ -201,7 +201,7 @@ class FusionController(FieldController):
     def relax(self, seconds: float) -> bool:
         """Recovery (ours): the velocity-space window drops its obstacle critic for
         ``seconds`` and follows a new A* path (:meth:`ForceWindow.relax
-        <pathfuse.planners.fusion_window.ForceWindow.relax>`)."""
+        <pathfuse.planners.controllers.fusion_window.ForceWindow.relax>`)."""
         if self._window is None:
             return False
         self._window.relax(seconds)

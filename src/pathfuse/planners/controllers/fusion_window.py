@@ -18,7 +18,7 @@ the dynamic window decide *how*.  Each tick:
    committing them: the field's streamline from the robot, the fusion's
    *local path*;
 2. the reachable ``(v, omega)`` window is sampled and rolled out as ``dwa``
-   does (:func:`pathfuse.planners.dwa_kernel.dwa_choose`, ``dwa``'s default
+   does (:func:`pathfuse.planners.controllers.dwa_kernel.dwa_choose`, ``dwa``'s default
    critics), scored against that local path: distance from it and progress
    along it (agreement with the field), heading, speed, static clearance
    (``exp(-gap / 0.1 m)`` within 0.5 m) and the sensed discs predicted at
@@ -88,7 +88,7 @@ class ForceWindow:
         The tick (s).
     social : SocialParams, optional
         The social critics among sensed moving discs (ours,
-        :mod:`pathfuse.planners.social`; default: ``dwa``'s).
+        :mod:`pathfuse.planners.controllers.social`; default: ``dwa``'s).
     """
 
     def __init__(self, problem: Any, dt: float, social: Any = None) -> None:

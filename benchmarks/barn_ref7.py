@@ -28,7 +28,7 @@ import pathfuse
 from pathfuse.field.forces import att_force_xy
 from pathfuse.field.repulsion import grid_repulsion
 from pathfuse.io.gazebo import read_gazebo_world
-from pathfuse.planners import refs
+from pathfuse.planners.controllers import refs
 from pathfuse.studies.barn import BARN_BOUNDS, BARN_GOAL, BARN_START, find_worlds
 
 RADIUS = 0.22

@@ -12,7 +12,7 @@ import pytest
 from pathfuse import Budget, ConfigError, GridMap, Status, plan
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate, path_length
-from pathfuse.planners.apf import APFController, APFParams, force_at
+from pathfuse.planners.controllers.apf import APFController, APFParams, force_at
 from pathfuse.planners.registry import get_planner
 from pathfuse.planners.run import warm
 

@@ -28,6 +28,14 @@ LAYERS: list[tuple[str, ...]] = [
     ("studies",),
     ("cli", "web", "__init__", "__main__"),
 ]
+# inside planners/, low -> high: global planners never import a controller, and only the
+# modules that run a planner (run.py, kernel_cache.py) import both sides
+PLANNER_LAYERS: list[tuple[str, ...]] = [
+    ("registry", "params"),
+    ("globals", "base", "drive", "recovery"),
+    ("controllers",),
+    ("run", "kernel_cache"),
+]
 MAX_LINES = 600
 # modules allowed above MAX_LINES, each with the reason in docs/architecture.md
 LONG: set[str] = set()
@@ -99,6 +107,30 @@ def test_no_import_of_a_higher_layer(module):
     here = _layer(module)
     upward = sorted(t for t in GRAPH[module] if _layer(t) > here)
     assert not upward, f"{module} (layer {here}) imports higher layers: {upward}"
+
+
+def _planner_layer(module: str) -> int:
+    name = module.split(".")[2]
+    for i, names in enumerate(PLANNER_LAYERS):
+        if name in names:
+            return i
+    raise AssertionError(f"{module} is in no layer of PLANNER_LAYERS: add it")
+
+
+PLANNER_MODULES = sorted(m for m in MODULES if m.startswith("pathfuse.planners."))
+
+
+def test_every_planner_module_is_in_a_planner_layer():
+    for m in PLANNER_MODULES:
+        _planner_layer(m)
+
+
+@pytest.mark.parametrize("module", PLANNER_MODULES)
+def test_no_import_of_a_higher_planner_layer(module):
+    here = _planner_layer(module)
+    upward = sorted(t for t in GRAPH[module]
+                    if t.startswith("pathfuse.planners.") and _planner_layer(t) > here)
+    assert not upward, f"{module} (planners' layer {here}) imports higher ones: {upward}"
 
 
 def test_no_import_cycles():

@@ -24,7 +24,7 @@ import pathfuse.search.kernel as kernel_mod
 from pathfuse import Budget, ConfigError, GridMap, MapError, QueryError, Status
 from pathfuse.io.movingai import read_movingai
 from pathfuse.io.scenario import read_scen, scen_map_name
-from pathfuse.planners.astar import AStarParams, FollowController
+from pathfuse.planners.controllers.follow import AStarParams, FollowController
 from pathfuse.planners.params import PursuitParams
 from pathfuse.planners.registry import get_planner
 from pathfuse.planners.run import warm
@@ -359,7 +359,7 @@ def test_registry_entry():
     assert spec.params_cls is AStarParams and spec.global_planner == "astar"
     assert spec.uses_astar and spec.offline and spec.online and spec.description
     # the global planner it follows, the search's parameters, then the diff-drive path
-    # follower's (planners/rpp.py)
+    # follower's (planners/controllers/rpp.py)
     assert spec.defaults() == {"global_planner": "astar", "heuristic": "euclidean",
                                "corner_cutting": False, **dataclasses.asdict(PursuitParams())}
     warm(spec)

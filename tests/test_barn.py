@@ -318,7 +318,12 @@ def test_online_subgoal_planners_do_not_jump_over_a_fine_subgoal(barn_run):
 
 def test_default_subgoal_tolerance_is_at_least_one_move():
     from pathfuse.grid import GridMap
-    from pathfuse.planners.refs import Ref6Controller, Ref6Params, Ref7Controller, Ref7Params
+    from pathfuse.planners.controllers.refs import (
+        Ref6Controller,
+        Ref6Params,
+        Ref7Controller,
+        Ref7Params,
+    )
     from pathfuse.planners.registry import get_planner
     from pathfuse.planners.run import start_online
     from pathfuse.problem import Problem

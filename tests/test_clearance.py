@@ -12,7 +12,7 @@ from pathfuse import GridMap, plan, simulate
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.geometry import point_box_distance
 from pathfuse.metrics import collision_free, min_clearance
-from pathfuse.planners.global_astar import plan_global
+from pathfuse.planners.globals.astar import plan_global
 from pathfuse.problem import Problem
 from pathfuse.search.costaware import CLEARANCE_COST, clearance_multipliers
 from pathfuse.world import load_scenario

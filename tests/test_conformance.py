@@ -23,8 +23,8 @@ import pytest
 from pathfuse import Budget, ConfigError, GridMap, Status, plan, simulate
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate, path_length
-from pathfuse.planners.fusion import FusionParams
-from pathfuse.planners.global_astar import route
+from pathfuse.planners.controllers.fusion import FusionParams
+from pathfuse.planners.globals.astar import route
 from pathfuse.planners.registry import get_global_planner, get_planner, make_params, planner_names
 from pathfuse.planners.run import warm
 from pathfuse.problem import Problem
@@ -317,7 +317,7 @@ def check_episode(ep, name, sc):
             want = route(g, sc["start"], sc["goal"], sc["robot"]["radius"])
         else:  # another global planner: the waypoints of its plan on the static map (an
             # any-angle planner's are what plan() returns)
-            from pathfuse.planners.global_planners import run_global
+            from pathfuse.planners.globals.builtin import run_global
 
             pb = Problem.create(g, sc["start"], sc["goal"], sc["robot"]["radius"])
             want = run_global(spec.global_planner, pb).waypoints

@@ -10,7 +10,7 @@ import pytest
 from pathfuse import Status, plan, simulate
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, min_clearance
-from pathfuse.planners.dwa import DWAParams
+from pathfuse.planners.controllers.dwa import DWAParams
 from pathfuse.planners.registry import get_planner
 from pathfuse.planners.run import start_online
 from pathfuse.problem import Problem

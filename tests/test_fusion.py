@@ -16,7 +16,12 @@ from pathfuse import Budget, ConfigError, GridMap, Status, plan
 from pathfuse.field.forces import attractive_force, total_force
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate, path_length, r_ratio
-from pathfuse.planners.fusion import FusionController, FusionParams, follow_path, force_at
+from pathfuse.planners.controllers.fusion import (
+    FusionController,
+    FusionParams,
+    follow_path,
+    force_at,
+)
 from pathfuse.planners.registry import get_planner
 from pathfuse.planners.run import warm
 

@@ -1,4 +1,5 @@
-"""The fusion in velocity space on a diff-drive robot (pathfuse.planners.fusion_window)."""
+"""The fusion in velocity space on a diff-drive robot
+(pathfuse.planners.controllers.fusion_window)."""
 
 from __future__ import annotations
 

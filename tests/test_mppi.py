@@ -12,7 +12,7 @@ import pytest
 from pathfuse import GridMap, Status, plan, simulate
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, min_clearance, segment_clearances
-from pathfuse.planners.mppi import MPPIParams, clearance_field
+from pathfuse.planners.controllers.mppi import MPPIParams, clearance_field
 from pathfuse.planners.registry import get_planner, planner_names
 from pathfuse.planners.run import start_online
 from pathfuse.problem import Problem

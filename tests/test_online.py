@@ -14,10 +14,10 @@ import pathfuse
 from pathfuse import ConfigError, GridMap, Status
 from pathfuse.field.forces import repulsive_force
 from pathfuse.field.repulsion import disc_repulsion
-from pathfuse.planners.apf import APFParams
-from pathfuse.planners.astar import ReplanParams
 from pathfuse.planners.base import Controller
-from pathfuse.planners.global_astar import route
+from pathfuse.planners.controllers.apf import APFParams
+from pathfuse.planners.controllers.follow import ReplanParams
+from pathfuse.planners.globals.astar import route
 from pathfuse.planners.registry import (
     PlannerSpec,
     get_planner,

@@ -11,7 +11,7 @@ import pytest
 from pathfuse import Budget, GridMap, Status, plan
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate
-from pathfuse.planners.fusion import FusionParams, force_at
+from pathfuse.planners.controllers.fusion import FusionParams, force_at
 from pathfuse.studies.paper import (
     PAPER_VARIANT,
     PaperConfig,

@@ -22,7 +22,7 @@ import pytest
 import pathfuse
 from pathfuse import ConfigError, GridMap, Status, plan
 from pathfuse.planners import registry
-from pathfuse.planners.global_planners import run_global
+from pathfuse.planners.globals.builtin import run_global
 from pathfuse.problem import Problem
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -211,7 +211,7 @@ def test_preset_equals_follower_with_its_global_planner():
 
 def test_an_experiment_combines_global_planners_with_a_controller(tmp_path):
     from pathfuse.bench.experiment import parse_experiment
-    from pathfuse.planners.fusion import FusionParams
+    from pathfuse.planners.controllers.fusion import FusionParams
 
     text = """
 name: gp

@@ -15,7 +15,7 @@ from pathfuse.field.forces import repulsive_force
 from pathfuse.field.repulsion import grid_improved_repulsion
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate
-from pathfuse.planners.refs import (
+from pathfuse.planners.controllers.refs import (
     Ref6Controller,
     Ref6Params,
     improved_repulsive_force,

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from pathfuse import Budget, ConfigError, GridMap, Status, plan
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.metrics import collision_free, evaluate
-from pathfuse.planners.refs import Ref7Controller, Ref7Params, segment_ends
+from pathfuse.planners.controllers.refs import Ref7Controller, Ref7Params, segment_ends
 from pathfuse.planners.registry import get_planner
 from pathfuse.problem import Problem
 

@@ -1,4 +1,4 @@
-"""Regulated Pure Pursuit (pathfuse.planners.rpp), the path followers' controller on a
+"""Regulated Pure Pursuit (pathfuse.planners.controllers.rpp), the path followers' controller on a
 diff-drive robot: its geometry, episodes along corridors and on a BARN world, and the
 holonomic walk left exactly as it was."""
 
@@ -14,10 +14,8 @@ import pytest
 import pathfuse
 from pathfuse import simulate
 from pathfuse.grid import GridMap
-from pathfuse.planners.astar import FollowController, ReplanController
-from pathfuse.planners.params import PursuitParams
-from pathfuse.planners.registry import get_planner, make_params
-from pathfuse.planners.rpp import (
+from pathfuse.planners.controllers.follow import FollowController, ReplanController
+from pathfuse.planners.controllers.rpp import (
     CARROT_MARGIN_M,
     MODE_PURSUIT,
     MODE_ROTATE,
@@ -31,6 +29,8 @@ from pathfuse.planners.rpp import (
     regulated_speed,
     rpp_step,
 )
+from pathfuse.planners.params import PursuitParams
+from pathfuse.planners.registry import get_planner, make_params
 from pathfuse.planners.run import start_online
 from pathfuse.problem import Problem
 from pathfuse.result import ConfigError, Status

@@ -1,5 +1,6 @@
-"""Social behaviour among moving discs (ours; pathfuse.planners.social): personal space over
-the predicted gaps and a committed passing side, in dwa, the fusion's window and mppi."""
+"""Social behaviour among moving discs (ours; pathfuse.planners.controllers.social):
+personal space over the predicted gaps and a committed passing side, in dwa, the fusion's
+window and mppi."""
 
 from __future__ import annotations
 
@@ -9,10 +10,10 @@ import numpy as np
 import pytest
 
 from pathfuse.grid import GridMap
-from pathfuse.planners import dwa_kernel as K
-from pathfuse.planners.fusion_window import ForceWindow
+from pathfuse.planners.controllers import dwa_kernel as K
+from pathfuse.planners.controllers.fusion_window import ForceWindow
+from pathfuse.planners.controllers.social import COMMIT_M, PassingSides
 from pathfuse.planners.params import SocialParams
-from pathfuse.planners.social import COMMIT_M, PassingSides
 from pathfuse.problem import Problem
 from pathfuse.robot import RobotModel
 from pathfuse.sweep import disc_sweep_gaps

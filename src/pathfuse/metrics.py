@@ -70,6 +70,7 @@ __all__ = [
     "in_bounds",
     "r_ratio",
     "evaluate",
+    "PlanInfo",
 ]
 
 
@@ -279,3 +280,27 @@ def evaluate(grid: GridMap, result: PlanResult, robot_radius_m: float = 0.0) -> 
         "in_bounds": inside,
         "collision_free": _is_free(clearance, inside, r),
     }
+
+
+class PlanInfo(dict):
+    """``PlanResult.info`` of the registered planners: a dict that also answers
+    ``info["min_clearance_m"]``, the least gap between the robot disc along the path and
+    any occupied square (metres; ``inf`` on an empty map), computed on first access by
+    :func:`min_clearance` (independently of the planner), so that a
+    caller who never asks pays nothing.  It pickles as a plain dict."""
+
+    _bound: tuple[Any, np.ndarray, float] | None = None
+
+    def bind(self, grid: Any, path: np.ndarray, radius_m: float) -> None:
+        self._bound = (grid, path, float(radius_m))
+
+    def __missing__(self, key: Any) -> Any:
+        if key != "min_clearance_m" or self._bound is None:
+            raise KeyError(key)
+        grid, path, r = self._bound
+        v = min_clearance(grid, path) - r if path.shape[0] else math.nan
+        self[key] = v
+        return v
+
+    def __reduce__(self) -> Any:
+        return (dict, (dict(self),))

@@ -1,19 +1,15 @@
 """Planners: a global planner plus a local controller, every one registered in
-:mod:`pathfuse.planners.registry` (global planners, controllers and the presets that
-combine them; plug-ins through the entry-point group ``pathfuse.planners``).
+:mod:`pathfuse.planners.registry` (plug-ins through the entry-point group
+``pathfuse.planners``).  The folder shows the split, as Nav2 splits its planner and
+controller servers:
 
-* :mod:`~pathfuse.planners.global_planners` - the built-in global planners (A*, jump
-  point search, A* smoothing, Theta*, Lazy Theta*, the visibility graph), registered
-  by name, and :func:`~pathfuse.planners.global_planners.run_global`;
-* :mod:`~pathfuse.planners.global_astar` - grid A* on the robot's c-space;
-* :mod:`~pathfuse.planners.base` - the controller interface and the shared
-  potential-field controller;
-* :mod:`~pathfuse.planners.astar`, :mod:`~pathfuse.planners.apf`,
-  :mod:`~pathfuse.planners.fusion`, :mod:`~pathfuse.planners.refs`,
-  :mod:`~pathfuse.planners.dwa`, :mod:`~pathfuse.planners.mppi` - the controllers
-  and their presets; :mod:`~pathfuse.planners.anyangle` - the presets of the path
-  follower on the other global planners;
-* :mod:`~pathfuse.planners.run` - running a planner offline or online.
+* :mod:`pathfuse.planners.globals` - the global planners: a problem in, a path out;
+* :mod:`pathfuse.planners.controllers` - the controllers, each with its presets and kernel;
+* here, what both sides and their callers share: the registry, the parameter groups
+  (:mod:`~pathfuse.planners.params`), the controller interface
+  (:mod:`~pathfuse.planners.base`, with :mod:`~pathfuse.planners.drive` and
+  :mod:`~pathfuse.planners.recovery`, which its ``command`` runs) and
+  :mod:`~pathfuse.planners.run`, which runs a global planner, then a controller.
 """
 
 from pathfuse.planners.registry import (

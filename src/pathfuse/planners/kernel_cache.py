@@ -29,7 +29,7 @@ def cold_kernels(spec: Any, params: Any = None, diff_drive: bool = False) -> lis
     kernels: list[Any] = []
     gname = spec.global_planner_of(params)
     if gname is not None:
-        from pathfuse.planners.global_planners import global_kernels
+        from pathfuse.planners.globals.builtin import global_kernels
 
         kernels.extend(global_kernels(gname))
     if spec.controller is not None:

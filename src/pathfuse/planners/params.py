@@ -190,7 +190,8 @@ class DiscParams(Checked):
 
 @dataclass(frozen=True)
 class PersonalSpaceParams(Checked):
-    """Personal space among sensed moving discs (ours; :mod:`pathfuse.planners.social`)."""
+    """Personal space among sensed moving discs (ours;
+    :mod:`pathfuse.planners.controllers.social`)."""
 
     social: bool = param(True, help="social critics among sensed moving discs (ours): "
                                     "personal space over the predicted gaps (and, in dwa and "
@@ -220,7 +221,7 @@ _DD = " (diff-drive robot online; no effect on a holonomic robot)"
 @dataclass(frozen=True)
 class PursuitParams(Checked):
     """Regulated Pure Pursuit, the path followers' controller on a diff-drive robot
-    (:mod:`pathfuse.planners.rpp`; Nav2's defaults unless the help says otherwise)."""
+    (:mod:`pathfuse.planners.controllers.rpp`; Nav2's defaults unless the help says otherwise)."""
 
     lookahead_time_s: float = param(
         1.5, gt=0, le=60, unit="s",

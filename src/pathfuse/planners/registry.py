@@ -7,7 +7,7 @@ As in Nav2, a *global planner* turns a problem into a path and a *controller*
   the (N, 2) waypoints in metres from the start to the goal, or None when it
   finds no path (the built-in ``astar``, ``astar-smooth``, ``thetastar``,
   ``lazy-thetastar``, ``shortest`` and ``jps`` are registered this way, in
-  :mod:`pathfuse.planners.global_planners`);
+  :mod:`pathfuse.planners.globals.builtin`);
 * :func:`register_controller` ``(name, cls)``: a Controller subclass;
 * :func:`register` a :class:`PlannerSpec`: a *preset* of a controller, a
   default global planner and a frozen parameter dataclass holding one set of
@@ -223,7 +223,7 @@ class GlobalPlannerSpec:
         (N, 2) waypoints in metres, or None for no path.  A function that
         also declares a ``params`` parameter receives the planner's
         parameters, one that declares ``max_expansions`` the search cap; the
-        built-in ones return a :class:`~pathfuse.planners.global_astar.GlobalPlan`.
+        built-in ones return a :class:`~pathfuse.planners.globals.astar.GlobalPlan`.
     description : str
         One line for ``pathfuse planners``.
     warmup : callable or None
@@ -433,8 +433,9 @@ def _load_builtin() -> None:
     _LOADED = True
     import importlib
 
-    for mod in ("global_planners", "astar", "apf", "fusion", "refs", "anyangle", "dwa",
-                "mppi"):
+    for mod in ("globals.builtin", "controllers.follow", "controllers.apf",
+                "controllers.fusion", "controllers.refs", "controllers.anyangle",
+                "controllers.dwa", "controllers.mppi"):
         importlib.import_module(f"pathfuse.planners.{mod}")
     try:
         load_plugins()

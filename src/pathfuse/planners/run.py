@@ -13,16 +13,16 @@ compilation.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from pathfuse.metrics import PlanInfo
 from pathfuse.planners.base import Controller, Observed
-from pathfuse.planners.global_astar import GlobalPlan
-from pathfuse.planners.global_planners import run_global
+from pathfuse.planners.globals.astar import GlobalPlan
+from pathfuse.planners.globals.builtin import run_global
 from pathfuse.planners.registry import PlannerSpec
 from pathfuse.problem import Problem
 from pathfuse.result import PlanResult, Status, path_length
@@ -58,7 +58,7 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
     if segments and not _WARM_SEGMENT:
         _warm_segments()
     if gname is not None:
-        from pathfuse.planners.global_planners import warm_global
+        from pathfuse.planners.globals.builtin import warm_global
 
         warm_global(gname)
     if spec.controller is not None:
@@ -105,10 +105,11 @@ def _astar_info(gp: GlobalPlan | None) -> dict[str, Any]:
 
 def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     """Plan ``problem`` with ``spec`` offline (the body of :func:`pathfuse.plan`)."""
+    segments = _needs_segments(spec, problem.robot_radius_m)
     bad = problem.failure()
     if bad is not None:
         return PlanResult(bad[0], planner=spec.name, message=bad[1])
-    warm(spec, params=params, segments=_needs_segments(spec, problem.robot_radius_m))
+    warm(spec, params=params, segments=segments)
     budget = problem.budget
     if spec.function is not None:
         res = spec.function(problem.grid, np.array(problem.start), np.array(problem.goal),
@@ -138,32 +139,6 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     length = out.length_m if out.length_m is not None else path_length(out.path)
     return PlanResult(out.status, out.path, length, (gp.time_s if gp else 0.0) + out.time_s,
                       spec.name, gp.expansions if gp else 0, out.steps, out.message, info)
-
-
-class PlanInfo(dict):
-    """``PlanResult.info`` of the registered planners: a dict that also answers
-    ``info["min_clearance_m"]``, the least gap between the robot disc along the path and
-    any occupied square (metres; ``inf`` on an empty map), computed on first access by
-    :func:`pathfuse.metrics.min_clearance` (independently of the planner), so that a
-    caller who never asks pays nothing.  It pickles as a plain dict."""
-
-    _bound: tuple[Any, np.ndarray, float] | None = None
-
-    def bind(self, grid: Any, path: np.ndarray, radius_m: float) -> None:
-        self._bound = (grid, path, float(radius_m))
-
-    def __missing__(self, key: Any) -> Any:
-        if key != "min_clearance_m" or self._bound is None:
-            raise KeyError(key)
-        from pathfuse.metrics import min_clearance
-
-        grid, path, r = self._bound
-        v = min_clearance(grid, path) - r if path.shape[0] else math.nan
-        self[key] = v
-        return v
-
-    def __reduce__(self) -> Any:
-        return (dict, (dict(self),))
 
 
 def _renamed(res: PlanResult, name: str) -> PlanResult:

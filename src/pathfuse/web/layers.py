@@ -171,7 +171,7 @@ def closed_order(problem: Problem, heuristic: str = "euclidean",
     """:func:`closed_set` and the same cells in the order the search expanded them
     (row-major indices, :meth:`~pathfuse.search.astar.AStarSearcher.expansion_order`), or
     None when the problem fails before any search."""
-    from pathfuse.planners.global_astar import snap_cell
+    from pathfuse.planners.globals.astar import snap_cell
     from pathfuse.search.astar import AStarSearcher
 
     if problem.failure() is not None:

@@ -209,7 +209,7 @@ def plan_request(store: MapStore, body: Any, limits: Limits) -> dict[str, Any]:
                         "robot_radius": radius}
     r1 = getattr(cfg, "r1_m", None)
     if "attractors" in layers and on_astar and r1 is not None and len(result.path):
-        from pathfuse.planners.global_astar import plan_global
+        from pathfuse.planners.globals.astar import plan_global
         from pathfuse.web.layers import attractors
 
         gp = plan_global(problem, heuristic)

@@ -47,7 +47,7 @@ import numpy as np
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.grid import GridMap
 from pathfuse.limits import LimitError, env_name, limit
-from pathfuse.planners.global_astar import route as global_route
+from pathfuse.planners.globals.astar import route as global_route
 from pathfuse.result import ConfigError
 from pathfuse.sweep import segment_static_distance
 from pathfuse.validate import short as _shown

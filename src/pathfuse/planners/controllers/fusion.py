@@ -1,7 +1,7 @@
 """The A*-APF fusion planner (paper Section III.C, Algorithm 2), registered as ``"fusion"``.
 
 Step 1 plans a global path with grid A*
-(:mod:`pathfuse.planners.global_astar`), or with the global planner that the
+(:mod:`pathfuse.planners.globals.astar`), or with the global planner that the
 parameter ``global_planner`` names (ours: any registered one, a plug-in's
 too); if it fails its status is returned.
 Step 2 starts the robot at ``start`` and repeats, until the goal is reached:
@@ -88,6 +88,7 @@ from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController, sensed_discs
+from pathfuse.planners.controllers.replan import replan_around_discs
 from pathfuse.planners.params import (
     DiscParams,
     FieldParams,
@@ -96,7 +97,6 @@ from pathfuse.planners.params import (
     SocialParams,
 )
 from pathfuse.planners.registry import PlannerSpec, register
-from pathfuse.planners.replan import replan_around_discs
 from pathfuse.problem import Problem
 from pathfuse.validate import param
 
@@ -192,7 +192,7 @@ class FusionController(FieldController):
         rb = problem.robot
         self._window: Any = None
         if self.online and rb is not None and rb.is_diff_drive and p.velocity_space:
-            from pathfuse.planners.fusion_window import ForceWindow
+            from pathfuse.planners.controllers.fusion_window import ForceWindow
 
             self._window = ForceWindow(problem, float(self.dt),  # type: ignore[arg-type]
                                        social=p, among_discs=p.among_discs, seed=p.seed)
@@ -204,7 +204,7 @@ class FusionController(FieldController):
 
     def command(self, obs: Any) -> np.ndarray:
         """On a diff-drive robot with ``velocity_space`` (ours): Algorithm 2's move for this
-        tick scored in velocity space (:mod:`pathfuse.planners.fusion_window`), then the
+        tick scored in velocity space (:mod:`pathfuse.planners.controllers.fusion_window`), then the
         shield; otherwise as every controller (:meth:`Controller.command`)."""
         if self._window is None:
             return super().command(obs)
@@ -244,7 +244,7 @@ class FusionController(FieldController):
     def relax(self, seconds: float) -> bool:
         """Recovery (ours): the velocity-space window drops its obstacle critic for
         ``seconds`` and follows a new A* path (:meth:`ForceWindow.relax
-        <pathfuse.planners.fusion_window.ForceWindow.relax>`)."""
+        <pathfuse.planners.controllers.fusion_window.ForceWindow.relax>`)."""
         if self._window is None:
             return False
         self._window.relax(seconds)
@@ -306,8 +306,8 @@ class FusionController(FieldController):
 
     @classmethod
     def diff_drive_kernels(cls) -> Sequence[Any]:
-        from pathfuse.planners.dwa_kernel import dwa_choose, route_tangent
-        from pathfuse.planners.mppi import MPPIController
+        from pathfuse.planners.controllers.dwa_kernel import dwa_choose, route_tangent
+        from pathfuse.planners.controllers.mppi import MPPIController
 
         return (dwa_choose, route_tangent, *MPPIController.kernels())
 
@@ -322,8 +322,8 @@ class FusionController(FieldController):
 
     @classmethod
     def warmup_diff_drive(cls) -> None:
-        from pathfuse.planners.dwa import DWAController
-        from pathfuse.planners.mppi import MPPIController
+        from pathfuse.planners.controllers.dwa import DWAController
+        from pathfuse.planners.controllers.mppi import MPPIController
 
         DWAController.warmup()  # the velocity-space fusion scores with dwa's window
         MPPIController.warmup()  # and among discs with MPPI's sequences

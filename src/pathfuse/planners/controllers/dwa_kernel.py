@@ -1,4 +1,4 @@
-"""The numba kernel of the Dynamic Window Approach (see :mod:`pathfuse.planners.dwa`).
+"""The numba kernel of the Dynamic Window Approach (see :mod:`pathfuse.planners.controllers.dwa`).
 
 :func:`dwa_choose` samples the commands reachable within one tick, rolls each
 out over the horizon, scores it and returns the best; :func:`dwa_progress`
@@ -184,7 +184,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
              sides):
     """Score one sample: ``out = [cost, admissible, first_tick_clear]``; ``sides[j] = (side,
     least predicted gap)`` of the sample against sensed disc ``j`` (the social critics,
-    :mod:`pathfuse.planners.social`; ``(tx, ty)`` the route's direction)."""
+    :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction)."""
     ox = f[D_OX]
     oy = f[D_OY]
     res = f[D_RES]
@@ -326,8 +326,8 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
     side_cost = 0.0
     personal = f[D_PERSONAL]
     if n_disc > 0 and (f[D_WSOC] > 0.0 or f[D_WSIDE] > 0.0):
-        # ours (pathfuse.planners.social): personal space over the predicted gaps, and the
-        # committed passing sides
+        # ours (pathfuse.planners.controllers.social): personal space over the predicted
+        # gaps, and the committed passing sides
         for j in range(n_disc):
             gj = sides[j, 1]
             if gj < personal:
@@ -400,7 +400,7 @@ def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, c
 
     ``dside`` holds the committed passing side of each sensed disc (+1, -1, 0: none) and
     ``chosen`` receives the best sample's ``(side, predicted gap)`` against each
-    (:mod:`pathfuse.planners.social`); the side is told against the route direction
+    (:mod:`pathfuse.planners.controllers.social`); the side is told against the route direction
     ``f[D_TX], f[D_TY]`` (:func:`set_route`), or the path's at ``k`` when that is zero.
 
     ``(c0, c1)`` is the last command: ``(v, omega)`` for a diff-drive robot,

@@ -18,7 +18,7 @@ the dynamic window decide *how*.  Each tick:
    committing them: the field's streamline from the robot, the fusion's
    *local path*;
 2. the reachable ``(v, omega)`` window is sampled and rolled out as ``dwa``
-   does (:func:`pathfuse.planners.dwa_kernel.dwa_choose`, ``dwa``'s default
+   does (:func:`pathfuse.planners.controllers.dwa_kernel.dwa_choose`, ``dwa``'s default
    critics), scored against that local path: distance from it and progress
    along it (agreement with the field), heading, speed, static clearance
    (``exp(-gap / 0.1 m)`` within 0.5 m) and the sensed discs predicted at
@@ -52,7 +52,7 @@ import numpy as np
 from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.base import sensed_discs
-from pathfuse.planners.dwa_kernel import (
+from pathfuse.planners.controllers.dwa_kernel import (
     dwa_choose,
     dwa_progress,
     pack_dwa,
@@ -61,7 +61,7 @@ from pathfuse.planners.dwa_kernel import (
     set_keep_reference,
     set_route,
 )
-from pathfuse.planners.social import PassingSides, disc_ids
+from pathfuse.planners.controllers.social import PassingSides, disc_ids
 
 __all__ = ["ForceWindow", "PASSIVE_WINDOW"]
 
@@ -88,7 +88,7 @@ class ForceWindow:
         The tick (s).
     social : SocialParams, optional
         The social critics among sensed moving discs (ours,
-        :mod:`pathfuse.planners.social`; default: ``dwa``'s).
+        :mod:`pathfuse.planners.controllers.social`; default: ``dwa``'s).
     among_discs : {"mppi", "window"}
         Who tracks the local path while a moving disc is sensed (ours): MPPI's
         sampled sequences, or the dynamic window as without discs.
@@ -98,7 +98,7 @@ class ForceWindow:
 
     def __init__(self, problem: Any, dt: float, social: Any = None,
                  among_discs: str = "mppi", seed: int = 0) -> None:
-        from pathfuse.planners.dwa import DWAParams
+        from pathfuse.planners.controllers.dwa import DWAParams
 
         rb = problem.robot
         p = DWAParams()
@@ -162,7 +162,7 @@ class ForceWindow:
         self.relax_replan = True
 
     def _replan(self, x: float, y: float) -> None:
-        from pathfuse.planners.global_astar import plan_global
+        from pathfuse.planners.globals.astar import plan_global
 
         pb = self.problem
         gp = plan_global(pb.with_start((x, y)), "euclidean")
@@ -262,11 +262,11 @@ class ForceWindow:
     def _sequences(self, obs: Any, path: np.ndarray, kk: int, pts: np.ndarray, k: int,
                    dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray) -> np.ndarray:
         """Among sensed discs (``among_discs="mppi"``, ours): the command of MPPI's sampled
-        control sequences (:mod:`pathfuse.planners.mppi`, its defaults and critics) tracking
-        Algorithm 2's local path from the robot, then the A* path beyond the point nearest
-        that path's end.  A sequence can swerve or get away after it has accelerated, which
-        the window's one command held over the horizon cannot."""
-        from pathfuse.planners.mppi import MPPIController, MPPIParams
+        control sequences (:mod:`pathfuse.planners.controllers.mppi`, its defaults and
+        critics) tracking Algorithm 2's local path from the robot, then the A* path beyond
+        the point nearest that path's end.  A sequence can swerve or get away after it has
+        accelerated, which the window's one command held over the horizon cannot."""
+        from pathfuse.planners.controllers.mppi import MPPIController, MPPIParams
 
         if self._mppi is None:
             class _Plan:

@@ -86,7 +86,7 @@ import numpy as np
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
-from pathfuse.planners.dwa_kernel import (
+from pathfuse.planners.controllers.dwa_kernel import (
     dwa_choose,
     pack_dwa,
     relaxed,
@@ -94,10 +94,10 @@ from pathfuse.planners.dwa_kernel import (
     set_keep_reference,
     set_route,
 )
+from pathfuse.planners.controllers.replan import replan_around_discs
+from pathfuse.planners.controllers.social import PassingSides, disc_ids
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, SocialParams
 from pathfuse.planners.registry import PlannerSpec, register
-from pathfuse.planners.replan import replan_around_discs
-from pathfuse.planners.social import PassingSides, disc_ids
 from pathfuse.problem import Problem
 from pathfuse.result import Status
 from pathfuse.robot import RobotModel

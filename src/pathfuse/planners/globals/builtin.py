@@ -3,13 +3,13 @@
 
 A global planner is ``func(problem) -> (N, 2) waypoints in metres, or None``
 (:func:`~pathfuse.planners.registry.register_global_planner`).  The built-in
-ones return a :class:`~pathfuse.planners.global_astar.GlobalPlan` instead,
+ones return a :class:`~pathfuse.planners.globals.astar.GlobalPlan` instead,
 which carries what their searches know besides the path (expansions, the
 status of a search that ran out of budget, the grid cells):
 
 ``astar``
     Exact 8-connected grid A* on the robot's c-space
-    (:func:`~pathfuse.planners.global_astar.plan_global`; the planner's
+    (:func:`~pathfuse.planners.globals.astar.plan_global`; the planner's
     ``heuristic`` and ``corner_cutting``).
 ``jps``
     Jump point search (:mod:`pathfuse.search.jps`): the same optimal costs
@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.geometry import MARGIN_FRAC
-from pathfuse.planners.global_astar import GlobalPlan, plan_global, snap_cell
+from pathfuse.planners.globals.astar import GlobalPlan, plan_global, snap_cell
 from pathfuse.planners.registry import (
     _BUILTIN_GLOBAL,
     PluginError,

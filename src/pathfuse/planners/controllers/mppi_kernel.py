@@ -1,4 +1,5 @@
-"""The numba kernel of Model Predictive Path Integral control (see :mod:`pathfuse.planners.mppi`).
+"""The numba kernel of Model Predictive Path Integral control
+(see :mod:`pathfuse.planners.controllers.mppi`).
 
 :func:`mppi_optimise` runs one MPPI iteration: it builds the batch of control
 sequences (the nominal one, two pure-pursuit guides along the path, a braking
@@ -11,7 +12,7 @@ one float array (indices ``M_*``) filled by :func:`pack_mppi`.
 
 The static clearance of a point is read from a lower-bound field (metres from
 each cell centre of a fine lattice to the nearest occupied square, less half
-a lattice cell's diagonal; see :func:`pathfuse.planners.mppi.clearance_field`):
+a lattice cell's diagonal; see :func:`pathfuse.planners.controllers.mppi.clearance_field`):
 ``field[c] - |p - c|`` is a lower bound of the distance from ``p`` to the
 occupied squares (the distance is 1-Lipschitz).  Between two rollout points
 ``a`` and ``b`` at least ``c`` away from every obstacle, the whole segment is
@@ -316,7 +317,7 @@ def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_m
     tnow = 0.0
     hit = False
     peak = 0.0
-    # ours (pathfuse.planners.social): the least predicted gap to each disc
+    # ours (pathfuse.planners.controllers.social): the least predicted gap to each disc
     dgap = np.full(nd, np.inf)
     for t in range(n):
         h = f[M_DT] if t == 0 else f[M_MDT]

@@ -7,7 +7,7 @@ global planner runs from the robot's position on the map with the sensed
 discs' cells blocked (grown by the robot's radius for A*, which searches the
 c-space), and on the static map when the discs box the robot in.  ``dwa``
 replans so every ``replan_period_s``; the fusion in velocity space
-(:mod:`pathfuse.planners.fusion_window`) while it senses a disc.
+(:mod:`pathfuse.planners.controllers.fusion_window`) while it senses a disc.
 """
 
 from __future__ import annotations
@@ -46,11 +46,11 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
     name = params.global_planner
     if name != "astar":
         return _with_registered(problem, name, x, y, dpos, drad, params)
-    from pathfuse.planners.global_astar import plan_global
+    from pathfuse.planners.globals.astar import plan_global
 
     occ = None
     if drad.shape[0]:
-        from pathfuse.planners.astar import _rasterise_discs
+        from pathfuse.planners.controllers.follow import _rasterise_discs
 
         g = problem.grid
         occ = g.cspace(problem.robot_radius_m).occupied.copy()
@@ -68,12 +68,12 @@ def _with_registered(problem: Problem, name: str, x: float, y: float, dpos: np.n
     """The registered global planner ``name`` (not A*): on the map with the sensed discs'
     cells blocked (a global planner sees a map, not discs), or, when that leaves no path
     or boxes the robot in, on the static map."""
-    from pathfuse.planners.global_planners import run_global
+    from pathfuse.planners.globals.builtin import run_global
 
     here = problem.with_start((x, y))
     gp = None
     if drad.shape[0]:
-        from pathfuse.planners.astar import _rasterise_discs
+        from pathfuse.planners.controllers.follow import _rasterise_discs
 
         g = problem.grid
         occ = g.occupied.copy()

@@ -2,7 +2,7 @@
 
 ``astar``
     Exact 8-connected grid A* between cell centres
-    (:mod:`pathfuse.planners.global_astar`).  Offline, :func:`pathfuse.plan`
+    (:mod:`pathfuse.planners.globals.astar`).  Offline, :func:`pathfuse.plan`
     returns the A* path through the cell centres from the start cell to the
     goal cell; its length is the A* cost (a straight move is one cell side,
     a diagonal ``sqrt(2)`` sides, times the resolution), and
@@ -10,7 +10,7 @@
     :func:`pathfuse.simulate` walks the path (start, centres, goal) at full
     speed, blind to moving discs: the paper's "A* cannot handle dynamic
     obstacles", made measurable.  On a diff-drive robot it follows the path
-    with Regulated Pure Pursuit (:mod:`pathfuse.planners.rpp`, Nav2's
+    with Regulated Pure Pursuit (:mod:`pathfuse.planners.controllers.rpp`, Nav2's
     follower), still blind to moving discs.  ``astar-follow`` is an older
     name of it.
 ``astar-replan``
@@ -52,7 +52,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.planners.base import Controller, Observed, Outcome
-from pathfuse.planners.global_astar import plan_global
+from pathfuse.planners.globals.astar import plan_global
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, PursuitParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -109,10 +109,10 @@ def _cumlen(path: np.ndarray) -> np.ndarray:
 
 class FollowController(Controller):
     """Walk the global path at full speed (offline: return it as planned); on a diff-drive
-    robot, follow it with Regulated Pure Pursuit (:mod:`pathfuse.planners.rpp`).
+    robot, follow it with Regulated Pure Pursuit (:mod:`pathfuse.planners.controllers.rpp`).
 
     It follows the path of any global planner.  A taut path (an any-angle one, or a
-    plug-in's: :attr:`GlobalPlan.taut <pathfuse.planners.global_astar.GlobalPlan.taut>`)
+    plug-in's: :attr:`GlobalPlan.taut <pathfuse.planners.globals.astar.GlobalPlan.taut>`)
     turns where it touches the robot's clearance around an obstacle corner, so a move
     across a corner would come closer than the radius: a holonomic robot's walk then ends
     a tick's move on the next corner (at most one tick per corner, and these paths have
@@ -137,7 +137,7 @@ class FollowController(Controller):
         self._rpp: Any = None
         rb = problem.robot
         if self.online and rb is not None and rb.is_diff_drive:
-            from pathfuse.planners.rpp import RegulatedPurePursuit
+            from pathfuse.planners.controllers.rpp import RegulatedPurePursuit
 
             dt, top = float(self.dt), float(self.max_speed)  # type: ignore[arg-type]
             self._rpp = RegulatedPurePursuit(problem, params, dt, top)
@@ -175,13 +175,13 @@ class FollowController(Controller):
 
     @classmethod
     def diff_drive_kernels(cls) -> Sequence[Any]:
-        from pathfuse.planners.rpp import rpp_step
+        from pathfuse.planners.controllers.rpp import rpp_step
 
         return (rpp_step,)
 
     @classmethod
     def warmup_diff_drive(cls) -> None:
-        from pathfuse.planners.rpp import warmup_rpp
+        from pathfuse.planners.controllers.rpp import warmup_rpp
 
         warmup_rpp()
 

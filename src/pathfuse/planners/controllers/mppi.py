@@ -92,7 +92,7 @@ from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
-from pathfuse.planners.mppi_kernel import mppi_optimise, pack_mppi, path_inflation
+from pathfuse.planners.controllers.mppi_kernel import mppi_optimise, pack_mppi, path_inflation
 from pathfuse.planners.params import GlobalAStarParams, PersonalSpaceParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -315,7 +315,7 @@ class MPPIController(Controller):
         self.seg_max = float(np.diff(self.cum).max()) if self.pts.shape[0] > 1 else 0.0
         self.k = 0
         if hasattr(self, "f"):
-            from pathfuse.planners.mppi_kernel import M_SEGMAX
+            from pathfuse.planners.controllers.mppi_kernel import M_SEGMAX
 
             self.f[M_SEGMAX] = self.seg_max
             self._baseline()
@@ -325,7 +325,7 @@ class MPPIController(Controller):
                                    bool(self.params.relative_inflation))
 
     def _replan(self, x: float, y: float) -> None:
-        from pathfuse.planners.global_astar import plan_global
+        from pathfuse.planners.globals.astar import plan_global
 
         pb = self.problem
         occ = None
@@ -333,7 +333,7 @@ class MPPIController(Controller):
         if drad.shape[0]:
             # the sensed discs as blocked cells, as Nav2's obstacle layer puts what the
             # sensors see into the global costmap
-            from pathfuse.planners.astar import _rasterise_discs
+            from pathfuse.planners.controllers.follow import _rasterise_discs
 
             g = pb.grid
             occ = g.cspace(pb.robot_radius_m).occupied.copy()

@@ -1,13 +1,13 @@
 """The presets of the any-angle global planners, the true shortest path and jump point
 search: ``thetastar``, ``lazy-thetastar``, ``astar-smooth``, ``shortest`` and ``jps``.
 
-Each is a global planner of :mod:`pathfuse.planners.global_planners` plus the
+Each is a global planner of :mod:`pathfuse.planners.globals.builtin` plus the
 ``follow`` controller (as ``astar`` is):
 the global planner makes a path of straight sight lines from the start point
 to the goal point; offline :func:`pathfuse.plan` returns it, online
 :func:`pathfuse.simulate` walks it at full speed, blind to moving discs (as
 ``astar`` does; on a diff-drive robot with Regulated Pure Pursuit,
-:mod:`pathfuse.planners.rpp`).  ``Budget.max_iterations`` caps the global search's
+:mod:`pathfuse.planners.controllers.rpp`).  ``Budget.max_iterations`` caps the global search's
 expansions.
 
 ``thetastar``
@@ -51,9 +51,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from pathfuse.planners.astar import FollowController
-from pathfuse.planners.global_astar import GlobalPlan
-from pathfuse.planners.global_planners import PathPlan, run_global
+from pathfuse.planners.controllers.follow import FollowController
+from pathfuse.planners.globals.astar import GlobalPlan
+from pathfuse.planners.globals.builtin import PathPlan, run_global
 from pathfuse.planners.params import (
     GLOBAL_PLANNER_HELP,
     GlobalAStarParams,
@@ -70,7 +70,7 @@ __all__ = ["ThetaStarParams", "LazyThetaStarParams", "SmoothParams", "ShortestPa
 #: The presets of this module (each one's default global planner has its name).
 ANY_ANGLE = ("thetastar", "lazy-thetastar", "astar-smooth", "shortest", "jps")
 
-#: An older name of :class:`~pathfuse.planners.global_planners.PathPlan`.
+#: An older name of :class:`~pathfuse.planners.globals.builtin.PathPlan`.
 AnyAnglePlan = PathPlan
 
 
@@ -116,7 +116,7 @@ class JPSParams(PursuitParams, GlobalChoice):
 def plan_any_angle(kind: str, problem: Problem, params: Any,
                    max_expansions: int | None = None) -> GlobalPlan:
     """Run the global planner ``kind`` for ``problem`` (an older name of
-    :func:`~pathfuse.planners.global_planners.run_global`)."""
+    :func:`~pathfuse.planners.globals.builtin.run_global`)."""
     return run_global(kind, problem, params, max_expansions)
 
 

@@ -8,7 +8,7 @@ initial path, and then sequentially uses each inflection point of the
 initial path as a sub-target point, and uses the improved artificial
 potential field method of local path planning to obtain the final path".
 
-1. Grid A* (:mod:`pathfuse.planners.global_astar`) gives the initial path.
+1. Grid A* (:mod:`pathfuse.planners.globals.astar`) gives the initial path.
 2. Its *inflection points* - the interior points where the direction of
    travel changes (:func:`inflection_points`) - then the goal are the
    sub-goals, visited in order: a sub-goal is passed within
@@ -41,7 +41,7 @@ together".
    also absorbs an end next to an obstacle that the plain repulsion would
    keep the robot from), the goal within ``goal_tolerance_m``.
 
-Both are :class:`~pathfuse.planners.apf.SubgoalController` s, so offline and
+Both are :class:`~pathfuse.planners.controllers.apf.SubgoalController` s, so offline and
 online they run the same numba loop as ``apf``
 (:func:`pathfuse.field.kernels.field_loop`).  ``info`` holds the A* path
 (``astar_path``, ``astar_length``, ``astar_time_s``), ``subgoals`` (K, 2) (the
@@ -74,7 +74,7 @@ import numpy as np
 
 from pathfuse.field.forces import K_REP, RHO0_M, repulsive_force, repulsive_potential
 from pathfuse.field.kernels import S_SUB
-from pathfuse.planners.apf import SubgoalController
+from pathfuse.planners.controllers.apf import SubgoalController
 from pathfuse.planners.params import DiscParams, FieldParams, GlobalAStarParams, GlobalChoice
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.validate import integer, number, param

@@ -1,8 +1,8 @@
 """Social behaviour among moving discs (people), shared by ``dwa``, the fusion's window and
 ``mppi`` (ours; after the proxemics and passing conventions of social navigation).
 
-Two critics of the sampled rollouts (in :mod:`pathfuse.planners.dwa_kernel` and
-:mod:`pathfuse.planners.mppi_kernel`), on by default whenever a moving disc is sensed:
+Two critics of the sampled rollouts (in :mod:`pathfuse.planners.controllers.dwa_kernel` and
+:mod:`pathfuse.planners.controllers.mppi_kernel`), on by default whenever a moving disc is sensed:
 
 * **personal space**: each sensed disc is predicted at constant velocity over
   the rollout's horizon; a rollout whose least predicted gap to a disc falls

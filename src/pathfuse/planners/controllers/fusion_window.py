@@ -29,7 +29,19 @@ Where the local path's bearing is more than 60 degrees off the heading, or
 the window's best is to stand and turn, the robot turns on the spot towards
 it at the rate from which the turn can stop there (rotate to heading, as
 Regulated Pure Pursuit does: the window's 2.5 s constant-``omega`` rollouts
-wrap around and would spin past it).  When Algorithm 2 goes nowhere (its
+wrap around and would spin past it) -- but not while a moving disc is sensed
+(ours: the local path swings as discs come near, and a robot standing to turn
+was walked into).
+
+Among moving discs (ours, ``among_discs="mppi"``, the default): while a disc
+is sensed, MPPI's sampled control sequences (:mod:`pathfuse.planners.controllers.mppi`)
+track the local path, then the A* path beyond it, instead of the window.  A
+sequence can accelerate and then swerve or get away; one command held over
+the horizon cannot, and on the dynamic benchmark the window stood in the
+discs' way.  The fusion's controller also plans the A* path again around the
+sensed discs every ``replan_period_s`` (:mod:`pathfuse.planners.controllers.replan`,
+as ``dwa`` does), so the A* points that attract the robot lead around them.
+Without discs nothing of this runs: the static results (BARN) do not change.  When Algorithm 2 goes nowhere (its
 local path ends within a quarter of its nominal length of the robot) the
 A* path from the robot's progress takes its place.
 

@@ -166,6 +166,18 @@ class ForceWindow:
         self.relaxed_until = -1
         self.relax_replan = False
         self.f_relaxed = relaxed(self.f)
+        if among_discs == "mppi":
+            # built now, not at the first disc: its distance field would cost that tick
+            from pathfuse.planners.controllers.mppi import MPPIController, MPPIParams
+
+            class _Plan:
+                waypoints = np.array([problem.start, problem.goal], dtype=np.float64)
+
+            mp = MPPIParams(seed=self.seed, social=sp.social, social_weight=sp.social_weight,
+                            personal_m=sp.personal_m)
+            self._mppi = MPPIController(problem, mp, _Plan(), dt=float(dt),
+                                        max_speed=self.vmax)
+            self._mppi.replan_every = 0  # the fusion replans (FusionController)
 
     def relax(self, seconds: float) -> None:
         """Recovery (ours, as Nav2's clear-costmap): no obstacle critic and no margin for
@@ -278,18 +290,6 @@ class ForceWindow:
         critics) tracking Algorithm 2's local path from the robot, then the A* path beyond
         the point nearest that path's end.  A sequence can swerve or get away after it has
         accelerated, which the window's one command held over the horizon cannot."""
-        from pathfuse.planners.controllers.mppi import MPPIController, MPPIParams
-
-        if self._mppi is None:
-            class _Plan:
-                waypoints = pts
-
-            sp = self.social
-            mp = MPPIParams(seed=self.seed, social=sp.social, social_weight=sp.social_weight,
-                            personal_m=sp.personal_m)
-            self._mppi = MPPIController(self.problem, mp, _Plan(), dt=float(self.f[0]),
-                                        max_speed=self.vmax)
-            self._mppi.replan_every = 0  # the fusion replans (FusionController)
         m = self._mppi
         e = path[-1]
         k0 = min(max(int(k), 0), pts.shape[0] - 1)

@@ -195,21 +195,3 @@ def test_impossible_connection_raises():
     with pytest.raises(MapError, match="after 40 attempts"):
         random_map((5.0, 1.0), obstacles=2, connect=[((0.5, 0.5), (4.5, 0.5))],
                    max_attempts=40)
-
-
-def test_small_map_flood_fill_agrees_with_scipy_labels():
-    """Small maps are flooded in Python (no scipy import), large ones labelled by scipy:
-    the same answer on every draw, occupied end cells included."""
-    from scipy import ndimage
-
-    from pathfuse.generate import _pairs_connected
-
-    rng = np.random.default_rng(1)
-    for _ in range(3000):
-        h, w = (int(v) for v in rng.integers(1, 12, size=2))
-        occ = rng.random((h, w)) < rng.random()
-        pairs = [((int(rng.integers(h)), int(rng.integers(w))),
-                  (int(rng.integers(h)), int(rng.integers(w))))
-                 for _ in range(int(rng.integers(1, 3)))]
-        labels, _ = ndimage.label(~occ)
-        assert _pairs_connected(occ, pairs) == all(labels[a] == labels[b] for a, b in pairs)

@@ -103,47 +103,6 @@ def _point_cell(grid_shape: tuple[int, int], origin: tuple[float, float], resolu
     return row, col
 
 
-_FLOOD_CELLS = 1 << 14  # up to this many cells a flood fill in Python beats importing scipy
-
-
-_Cell = tuple[int, int]
-
-
-def _pairs_connected(occ: np.ndarray, pairs: list[tuple[_Cell, _Cell]]) -> bool:
-    """Whether each pair of free cells is joined through free cells by 4-connected steps (which
-    no-corner-cut 8-connectivity equals).  A small map is flooded here (the paper's map:
-    ``scipy.ndimage`` would cost a command a third of a second to import), a large one
-    labelled by :func:`scipy.ndimage.label` (its default structure: 4-connectivity)."""
-    if occ.size > _FLOOD_CELLS:
-        from scipy import ndimage
-
-        labels, _ = ndimage.label(~occ)
-        return all(labels[a] == labels[b] for a, b in pairs)
-    h, w = occ.shape
-    free = (~occ).ravel().tolist()
-    label = [0] * (h * w)
-    n = 0
-    for a, b in pairs:
-        for r, c in (a, b):
-            p = r * w + c
-            if label[p] or not free[p]:
-                continue
-            n += 1
-            label[p] = n
-            todo = [p]
-            while todo:
-                q = todo.pop()
-                qc = q % w
-                for nb, ok in ((q - w, q >= w), (q + w, q < h * w - w), (q - 1, qc > 0),
-                               (q + 1, qc < w - 1)):
-                    if ok and free[nb] and not label[nb]:
-                        label[nb] = n
-                        todo.append(nb)
-        if label[a[0] * w + a[1]] != label[b[0] * w + b[1]]:  # occupied: 0, as scipy's
-            return False
-    return True
-
-
 def random_map(
     size_m: float | Sequence[float] = (15.0, 15.0),
     resolution: float = 1.0,
@@ -291,8 +250,12 @@ def random_map(
         occ: np.ndarray = np.zeros(n_cells, dtype=bool)
         occ[chosen] = True
         occ = occ.reshape(shape)
-        if pairs and not _pairs_connected(occ, pairs):
-            continue
+        if pairs:
+            from scipy import ndimage
+
+            labels, _ = ndimage.label(~occ)
+            if any(labels[a] != labels[b] for a, b in pairs):
+                continue
         meta = {"generator": "random_map", "seed": int(seed), "obstacles": count,
                 "attempts": attempt}
         return GridMap(occ, resolution=res, origin=(ox, oy), name=label, meta=meta)

@@ -8,6 +8,8 @@ the folder of the cold run before it.
 
 * ``import``: ``python -c "import pathfuse"``;
 * ``help``: ``pathfuse --help``;
+* ``numba``: ``import numba`` and a first compilation (of a one-line function): numba's
+  own start-up, which every first plan pays;
 * ``plan-<planner>``: ``pathfuse plan --map paper --planner <planner>``, cold and warm.
 
 Usage::
@@ -33,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 PATHFUSE = [sys.executable, "-m", "pathfuse.cli"]
+NUMBA_FLOOR = "import numba; numba.njit(lambda a: a + 1)(1)"
 
 
 def run(cmd: list[str], env: dict[str, str] | None = None) -> tuple[float, float]:
@@ -68,6 +71,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     out["import"] = summary([run([sys.executable, "-c", "import pathfuse"])
                              for _ in range(args.runs)])
     out["help"] = summary([run([*PATHFUSE, "--help"]) for _ in range(args.runs)])
+    # numba's own start-up, the floor under any first plan: its import and its first
+    # compilation (of a one-line function) in a process
+    out["numba"] = summary([run([sys.executable, "-c", NUMBA_FLOOR]) for _ in range(args.runs)])
     for planner in args.planners:
         cmd = [*PATHFUSE, "plan", "--map", "paper", "--planner", planner]
         cold, warm = [], []
@@ -84,7 +90,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     m = out["machine"]
     print(f"machine: {m['machine']}, {m['cores']} cores, load average {m['load']} at the start, "
           f"{out['load_end']} at the end; python {m['python']}")
-    for key in ("import", "help"):
+    for key in ("import", "help", "numba"):
         s = out[key]
         print(f"{key:<14} CPU {s['cpu_s']:.3f} s, wall {s['wall_s']:.3f} s (median of {s['runs']})")
     for planner in args.planners:

@@ -99,6 +99,12 @@ EMERGENCY = 2
 UNSAFE = 3
 EVADE = 4
 CODE_NAMES = ("asked", "nearest", "emergency", "unsafe", "evade")
+NV, NW = 7, 9
+"""The diff-drive window's samples: ``nv`` speeds x ``nw`` yaw rates (:func:`shield_unicycle`)."""
+ND = 12
+"""The holonomic shield's directions (:func:`shield_holonomic`).  Callers on the tick path
+pass ``NV, NW`` and ``ND`` explicitly: an omitted argument sends every call through
+numba's slow dispatch (the compiled version is looked up in Python, about 0.1-1 ms)."""
 """The name of each return code."""
 
 MAX_STOP_TICKS = 100_000
@@ -271,8 +277,8 @@ def shield_unicycle(occ: np.ndarray, ox: float, oy: float, res: float, x: float,
                     th: float, v0: float, w0: float, v: float, w: float, dt: float,
                     vmin: float, vmax: float, amax: float, wmax: float, alpha: float,
                     clear: float, radius: float, dpos: np.ndarray, dspeed: np.ndarray,
-                    drad: np.ndarray, disc_margin: float, nv: int = 7,
-                    nw: int = 9) -> tuple[float, float, int]:
+                    drad: np.ndarray, disc_margin: float, nv: int = NV,
+                    nw: int = NW) -> tuple[float, float, int]:
     """The shielded diff-drive command ``(v, w, code)`` (see the module docstring).
 
     ``(x, y, th)`` is the pose, ``(v0, w0)`` the last applied command,
@@ -345,7 +351,7 @@ def shield_holonomic(occ: np.ndarray, ox: float, oy: float, res: float, x: float
                      ux0: float, uy0: float, ux: float, uy: float, dt: float, vmax: float,
                      amax: float, clear: float, radius: float, dpos: np.ndarray,
                      dspeed: np.ndarray, drad: np.ndarray, disc_margin: float,
-                     nd: int = 12) -> tuple[float, float, int]:
+                     nd: int = ND) -> tuple[float, float, int]:
     """The shielded holonomic velocity ``(ux, uy, code)``: the asked velocity, else the
     nearest of ``nd`` directions x 4 speeds (each clipped as the world clips), else the
     emergency stop (see the module docstring)."""
@@ -426,8 +432,8 @@ def warmup_shield() -> None:
         clip_holonomic(0.0, 0.0, 1.0, 0.5, 0.1, 1.0, 2.0)
         for dp, dv, dr in ((d2, v2, r1), (d2[:0], v2[:0], r1[:0])):
             shield_unicycle(occ, 0.0, 0.0, 1.0, 0.5, 0.5, 0.0, 0.5, 0.0, 1.0, 0.5, 0.1, 0.0,
-                            1.0, 2.0, 2.0, 4.0, 0.2, 0.2, dp, dv, dr, 0.0)
+                            1.0, 2.0, 2.0, 4.0, 0.2, 0.2, dp, dv, dr, 0.0, NV, NW)
             shield_holonomic(occ, 0.0, 0.0, 1.0, 0.5, 0.5, 0.0, 0.0, 1.0, 0.5, 0.1, 1.0,
-                             2.0, 0.2, 0.2, dp, dv, dr, 0.0)
+                             2.0, 0.2, 0.2, dp, dv, dr, 0.0, ND)
             shield_holonomic(occ, 0.0, 0.0, 1.0, 0.5, 0.5, 0.0, 0.0, 1.0, 0.5, 0.1, 1.0,
-                             math.inf, 0.2, 0.2, dp, dv, dr, 0.0)
+                             math.inf, 0.2, 0.2, dp, dv, dr, 0.0, ND)

@@ -24,6 +24,8 @@ import os
 import threading
 import time
 
+from pathfuse.sigterm import Terminated, terminate_like_ctrl_c
+
 __all__ = ["watch_client", "client_alive", "Terminated", "terminate_like_ctrl_c"]
 
 EXIT_ORPHANED = 75
@@ -85,22 +87,3 @@ def watch_client(pid: int, poll_s: float = 0.5) -> threading.Thread:
                          daemon=True)
     t.start()
     return t
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised like Ctrl-C's ``KeyboardInterrupt`` so it ends a sweep the same way:
-    what finished is stored, the workers are stopped, the same command resumes."""
-
-    signame = "SIGTERM"
-
-
-def _raise_terminated(signum: int, frame: object) -> None:
-    raise Terminated()
-
-
-def terminate_like_ctrl_c() -> None:
-    """Make SIGTERM raise :class:`Terminated` in the main thread (the command line does)."""
-    import signal
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _raise_terminated)

@@ -464,7 +464,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return EXIT_USAGE
     _one_line_warnings(args.command)
-    from pathfuse.bench.lifeline import terminate_like_ctrl_c
+    from pathfuse.sigterm import terminate_like_ctrl_c
 
     terminate_like_ctrl_c()  # SIGTERM ends a command like Ctrl-C: one line, stored runs kept
     try:

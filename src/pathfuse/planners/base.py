@@ -251,7 +251,7 @@ class Controller:
 
     def _shielded(self, obs: Observed, a: np.ndarray) -> np.ndarray:
         from pathfuse.geometry import MARGIN_FRAC
-        from pathfuse.shield import shield_holonomic, shield_unicycle
+        from pathfuse.shield import ND, NV, NW, shield_holonomic, shield_unicycle
 
         pb = self.problem
         rb = pb.robot
@@ -275,13 +275,13 @@ class Controller:
                 dt, float(rb.min_speed_mps), float(rb.max_speed_mps),
                 float(rb.max_accel_mps2), float(rb.max_yaw_rate_radps),
                 float(rb.max_yaw_accel_radps2), clear,
-                float(pb.robot_radius_m), dp, dv, dr, 0.0)
+                float(pb.robot_radius_m), dp, dv, dr, 0.0, NV, NW)
         else:
             u, w, code = shield_holonomic(
                 g.occupied, ox, oy, res, float(obs.position[0]), float(obs.position[1]),
                 float(cmd[0]), float(cmd[1]), float(a[0]), float(a[1]), dt,
                 float(self.max_speed if self.max_speed is not None else rb.max_speed_mps),
-                float(rb.max_accel_mps2), clear, float(pb.robot_radius_m), dp, dv, dr, 0.0)
+                float(rb.max_accel_mps2), clear, float(pb.robot_radius_m), dp, dv, dr, 0.0, ND)
         self.shield_counts[code] += 1
         return np.array([u, w])
 

@@ -199,8 +199,8 @@ def _astar_kernel(
         sr = start // wp
         f0 = _heuristic(sr, start - sr * wp, gr, gc, octile)
         k0 = _bits_of(f0)
-        fh = -1
-        used = 0
+        fh = np.int64(-1)  # typed int64, not a literal: one signature of _qpush and _spush
+        used = np.int64(0)
         if use_ring:
             for i in range(_RING_SIZE):
                 heads[i] = -1
@@ -209,7 +209,7 @@ def _astar_kernel(
             last = np.uint64(0)
             cur = np.int64(f0 * _RING_SCALE)
             size = 0
-            ssize = _spush(skey, snode, 0, k0, start)
+            ssize = _spush(skey, snode, np.int64(0), k0, start)
         else:
             for i in range(65):
                 heads[i] = -1
@@ -252,7 +252,7 @@ def _astar_kernel(
                 heads[b] = -1
                 while e >= 0:
                     nxt = qnext[e]
-                    ssize = _spush(skey, snode, ssize, qkey[e], qnode[e])
+                    ssize = _spush(skey, snode, ssize, qkey[e], np.int64(qnode[e]))
                     size -= 1
                     qnext[e] = fh
                     fh = e
@@ -378,7 +378,7 @@ def _trace(cell, start, goal, wp, ox, oy, res):
     """The path from start to goal: ``(cells, points)``, the (n, 2) unpadded ``(row, col)``
     cells and their centres ``[x, y]`` for a grid of origin ``(ox, oy)`` and cell side
     ``res`` (one call, so a query pays one dispatch for both)."""
-    offs = np.array([1, -1, wp, -wp, wp + 1, wp - 1, -wp + 1, -wp - 1], dtype=np.int64)
+    offs = (1, -1, wp, -wp, wp + 1, wp - 1, -wp + 1, -wp - 1)  # a tuple: no np.array to compile
     n = 1
     p = goal
     while p != start:

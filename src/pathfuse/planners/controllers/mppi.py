@@ -391,7 +391,7 @@ class MPPIController(Controller):
     # ------------------------------------------------------------------ offline
     def _shield_offline(self, x: float, y: float, th: float, c0: float, c1: float, a0: float,
                         a1: float) -> tuple[float, float]:
-        from pathfuse.shield import shield_holonomic, shield_unicycle
+        from pathfuse.shield import ND, NV, NW, shield_holonomic, shield_unicycle
 
         rb = self.robot
         g = self.problem.grid
@@ -401,13 +401,14 @@ class MPPIController(Controller):
         if self.holonomic:
             u, w, code = shield_holonomic(g.occupied, ox, oy, float(g.resolution), x, y, c0,
                                           c1, a0, a1, self.tick_s, rb.max_speed_mps,
-                                          rb.max_accel_mps2, self.clear_m, r, z2, z1, z1, 0.0)
+                                          rb.max_accel_mps2, self.clear_m, r, z2, z1, z1, 0.0,
+                                          ND)
         else:
             u, w, code = shield_unicycle(g.occupied, ox, oy, float(g.resolution), x, y, th, c0,
                                          c1, a0, a1, self.tick_s, rb.min_speed_mps,
                                          rb.max_speed_mps, rb.max_accel_mps2,
                                          rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2,
-                                         self.clear_m, r, z2, z1, z1, 0.0)
+                                         self.clear_m, r, z2, z1, z1, 0.0, NV, NW)
         self.offline_shield[code] += 1
         return float(u), float(w)
 

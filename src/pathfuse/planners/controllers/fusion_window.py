@@ -33,6 +33,10 @@ wrap around and would spin past it) -- but not while a moving disc is sensed
 (ours: the local path swings as discs come near, and a robot standing to turn
 was walked into).
 
+When Algorithm 2 goes nowhere (its local path ends within a quarter of its
+nominal length of the robot) the A* path from the robot's progress takes its
+place.
+
 Among moving discs (ours, ``among_discs="mppi"``, the default): while a disc
 is sensed, MPPI's sampled control sequences (:mod:`pathfuse.planners.controllers.mppi`)
 track the local path, then the A* path beyond it, instead of the window.  A
@@ -41,9 +45,7 @@ the horizon cannot, and on the dynamic benchmark the window stood in the
 discs' way.  The fusion's controller also plans the A* path again around the
 sensed discs every ``replan_period_s`` (:mod:`pathfuse.planners.controllers.replan`,
 as ``dwa`` does), so the A* points that attract the robot lead around them.
-Without discs nothing of this runs: the static results (BARN) do not change.  When Algorithm 2 goes nowhere (its
-local path ends within a quarter of its nominal length of the robot) the
-A* path from the robot's progress takes its place.
+Without discs nothing of this runs: the static results (BARN) do not change.
 
 Recovery (ours): when the robot has moved less than 0.3 m in 3 s, A* is
 planned again from where it stands and followed for 4 s, then Algorithm 2

@@ -78,7 +78,6 @@ Examples
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 import weakref
@@ -93,6 +92,7 @@ from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
 from pathfuse.planners.controllers.mppi_kernel import mppi_optimise, pack_mppi, path_inflation
+from pathfuse.planners.controllers.replan import replan_around_discs
 from pathfuse.planners.params import GlobalAStarParams, PersonalSpaceParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -325,32 +325,14 @@ class MPPIController(Controller):
                                    bool(self.params.relative_inflation))
 
     def _replan(self, x: float, y: float) -> None:
-        from pathfuse.planners.globals.astar import plan_global
-
-        pb = self.problem
-        occ = None
         dpos, _, drad = self._sensed
-        if drad.shape[0]:
-            # the sensed discs as blocked cells, as Nav2's obstacle layer puts what the
-            # sensors see into the global costmap
-            from pathfuse.planners.controllers.follow import _rasterise_discs
-
-            g = pb.grid
-            occ = g.cspace(pb.robot_radius_m).occupied.copy()
-            _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
-                             dpos, drad, float(pb.robot_radius_m))
-        here = pb.with_start((x, y))
-        margin = self.params.replan_clearance_m
-        if margin > here.clearance_m:
-            # keep away from obstacles where the room allows (ours; Nav2's global costmap
-            # is inflated likewise)
-            here = dataclasses.replace(here, clearance_m=margin)
-        gp = plan_global(here, self.params.heuristic, occupied=occ)
-        if not gp.success and occ is not None:  # boxed in by the discs: the static path
-            gp = plan_global(here, self.params.heuristic)
+        # keep away from obstacles where the room allows (ours; Nav2's global costmap is
+        # inflated likewise)
+        pts = replan_around_discs(self.problem, x, y, dpos, drad, self.params,
+                                  clearance_m=self.params.replan_clearance_m)
         self.replans += 1
-        if gp.success:
-            self._set_path(np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2))
+        if pts is not None:
+            self._set_path(pts)
             self.global_path = self.pts
 
     # ------------------------------------------------------------------ one decision

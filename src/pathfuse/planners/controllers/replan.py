@@ -6,12 +6,13 @@ its default behaviour tree replans the global path once a second.
 global planner runs from the robot's position on the map with the sensed
 discs' cells blocked (grown by the robot's radius for A*, which searches the
 c-space), and on the static map when the discs box the robot in.  ``dwa``
-replans so every ``replan_period_s``; the fusion in velocity space
+and ``mppi`` replan so every ``replan_period_s``; the fusion in velocity space
 (:mod:`pathfuse.planners.controllers.fusion_window`) while it senses a disc.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
@@ -22,7 +23,8 @@ __all__ = ["replan_around_discs"]
 
 
 def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
-                        drad: np.ndarray, params: Any) -> np.ndarray | None:
+                        drad: np.ndarray, params: Any,
+                        clearance_m: float | None = None) -> np.ndarray | None:
     """Waypoints ``(M, 2)`` of a new global path from ``(x, y)`` to the goal, or None.
 
     Parameters
@@ -36,14 +38,17 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
         the static map).
     params
         The planner's parameters: ``global_planner`` names the global planner
-        (``"astar"`` searches with ``heuristic``).
+        (``"astar"`` when it has none; A* searches with ``heuristic``).
+    clearance_m : float, optional
+        A* only: the soft margin it keeps from obstacles where the room allows,
+        when larger than the problem's (``mppi``'s ``replan_clearance_m``).
 
     Returns
     -------
     ndarray or None
         None when no path is found (on the crowded map nor on the static one).
     """
-    name = params.global_planner
+    name = getattr(params, "global_planner", "astar")
     if name != "astar":
         return _with_registered(problem, name, x, y, dpos, drad, params)
     from pathfuse.planners.globals.astar import plan_global
@@ -57,6 +62,8 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
         _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
                          dpos, drad, float(problem.robot_radius_m))
     here = problem.with_start((x, y))
+    if clearance_m is not None and clearance_m > here.clearance_m:
+        here = dataclasses.replace(here, clearance_m=clearance_m)
     gp = plan_global(here, params.heuristic, occupied=occ)
     if not gp.success and occ is not None:  # boxed in by the discs: the static path
         gp = plan_global(here, params.heuristic)

@@ -160,3 +160,24 @@ def test_among_discs_the_same_seed_gives_the_same_episode():
     a = simulate(_head_on(), planner={"name": "fusion", "params": {"seed": 3}})
     b = simulate(_head_on(), planner={"name": "fusion", "params": {"seed": 3}})
     assert np.array_equal(a.positions, b.positions)
+
+
+def test_progress_indices_always_point_into_the_current_path():
+    """After a replan the walked points' progress indices (read by the escape's rejoin
+    search as indices into the path, unchecked in numba) refer to the new path."""
+    from pathfuse.world.scenario import load_scenario
+
+    sc = load_scenario(_head_on(0.3))
+    ctrl = _controller(sc)
+    world = World(sc)
+    obs = world.reset(0)
+    replanned = 0
+    for _ in range(world.n_steps):
+        before = ctrl.pts
+        obs, terminated, truncated, _ = world.step(ctrl.command(obs))
+        replanned += ctrl.pts is not before
+        assert 0 <= ctrl.kbuf[:ctrl.n].min() and ctrl.kbuf[:ctrl.n].max() < ctrl.pts.shape[0]
+        assert 0 <= ctrl.state[0] < ctrl.pts.shape[0]
+        if terminated or truncated:
+            break
+    assert replanned >= 1

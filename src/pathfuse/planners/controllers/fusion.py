@@ -239,6 +239,9 @@ class FusionController(FieldController):
         self.pts = np.require(pts, dtype=np.float64, requirements=("C", "W"))
         self.cum = polyline_cumlen(self.pts)
         self.state[S_K] = 0  # the new path starts where the robot stands
+        # the walked points' progress indices referred to the old path (the escape's rejoin
+        # search reads them as indices into the path): the new path's start for each
+        self.kbuf[:self.n] = 0
         self.global_path = self.pts
 
     def relax(self, seconds: float) -> bool:

@@ -181,3 +181,24 @@ def test_progress_indices_always_point_into_the_current_path():
         if terminated or truncated:
             break
     assert replanned >= 1
+
+
+def test_entering_among_discs_the_sequences_start_from_the_present_command(monkeypatch):
+    """MPPI's warm start is the optimum of its last call; when the fusion comes back among
+    discs after a stretch without, that optimum is seconds old: the sequences then start
+    from the command the robot is executing."""
+    from pathfuse.planners.controllers.mppi import MPPIController
+
+    seen = []
+    orig = MPPIController._choose
+
+    def spy(self, x, y, th, c0, c1, *a):
+        seen.append((self.nominal.copy(), c0, c1))
+        return orig(self, x, y, th, c0, c1, *a)
+
+    monkeypatch.setattr(MPPIController, "_choose", spy)
+    ctrl, ticks, info = _drive(_head_on())
+    assert seen
+    nominal, c0, c1 = seen[0]
+    assert np.all(nominal[:, 0] == c0) and np.all(nominal[:, 1] == c1)
+    assert c0 > 0.0  # the robot was driving when the disc came into range

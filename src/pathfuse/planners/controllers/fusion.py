@@ -173,12 +173,7 @@ class FusionController(FieldController):
         super().__init__(problem, params, plan, **kw)
         p = params
         g = problem.grid
-        pts = np.asarray(plan.waypoints, dtype=np.float64)
-        gx, gy = problem.goal
-        if pts.shape[0] == 0 or pts[-1, 0] != gx or pts[-1, 1] != gy:
-            pts = np.concatenate([pts.reshape(-1, 2), [[gx, gy]]])
-        self.pts = np.require(pts, dtype=np.float64, requirements=("C", "W"))
-        self.cum = polyline_cumlen(self.pts)
+        self._set_path(np.asarray(plan.waypoints, dtype=np.float64))
         ox, oy = g.origin
         window = p.stall_steps * self.step_m + 2.0 * (p.r1_m + g.resolution)
         self.f, self.i = pack_fusion(
@@ -218,6 +213,14 @@ class FusionController(FieldController):
             return a
         return self._shielded(obs, a)
 
+    def _set_path(self, pts: np.ndarray) -> None:
+        """The global path the A* points come from, ending at the goal."""
+        gx, gy = self.problem.goal
+        if pts.shape[0] == 0 or pts[-1, 0] != gx or pts[-1, 1] != gy:
+            pts = np.concatenate([pts.reshape(-1, 2), [[gx, gy]]])
+        self.pts = np.require(pts, dtype=np.float64, requirements=("C", "W"))
+        self.cum = polyline_cumlen(self.pts)
+
     def _replan_among_discs(self, obs: Any) -> None:
         """Ours (velocity space): while a disc is sensed, the global path again from the
         robot, around the discs, every ``replan_period_s`` (as ``dwa`` does; the A* points
@@ -233,11 +236,7 @@ class FusionController(FieldController):
         self.replans += 1
         if pts is None:
             return
-        gx, gy = self.problem.goal
-        if pts[-1, 0] != gx or pts[-1, 1] != gy:
-            pts = np.concatenate([pts, [[gx, gy]]])
-        self.pts = np.require(pts, dtype=np.float64, requirements=("C", "W"))
-        self.cum = polyline_cumlen(self.pts)
+        self._set_path(pts)
         self.state[S_K] = 0  # the new path starts where the robot stands
         # the walked points' progress indices referred to the old path (the escape's rejoin
         # search reads them as indices into the path): the new path's start for each

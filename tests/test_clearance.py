@@ -100,7 +100,7 @@ SCENARIOS = sorted(glob.glob("examples/scenarios/*.yaml"))
 @pytest.mark.parametrize("name", ["astar-replan", "apf", "fusion", "ref6", "ref7", "dwa"])
 def test_no_example_skims_a_wall_with_a_margin(path, name):
     sc = load_scenario(path)
-    robot = {"radius": sc.robot.radius, "sensing_radius": sc.robot.sensing_radius,
+    robot = {"radius": sc.robot.radius_m, "sensing_radius": sc.robot.sensing_radius_m,
              "clearance": 0.1}
     ep = simulate(sc, planner=name, robot=robot)
     if ep.collision_with != "static":
@@ -140,12 +140,12 @@ def test_a_diff_drive_robot_inflates_its_global_path_by_default():
 
 def test_the_inflation_key_of_a_robot_block():
     from pathfuse.result import ConfigError
-    from pathfuse.world.robot import RobotSpec, parse_robot
+    from pathfuse.robot import RobotModel
 
-    assert parse_robot({"model": "diff-drive"}).to_model().inflation_m == 0.3
-    assert parse_robot({"model": "diff-drive", "inflation": 0}).to_model().inflation_m == 0.0
-    assert parse_robot({"inflation": 0.5}).to_model().inflation_m == 0.5
-    m = parse_robot({"model": "diff-drive", "inflation": 0.2}).to_model()
-    assert RobotSpec.from_model(m).to_model() == m
+    assert RobotModel.from_dict({"model": "diff-drive"}).inflation_m == 0.3
+    assert RobotModel.from_dict({"model": "diff-drive", "inflation": 0}).inflation_m == 0.0
+    assert RobotModel.from_dict({"inflation": 0.5}).inflation_m == 0.5
+    m = RobotModel.from_dict({"model": "diff-drive", "inflation": 0.2})
+    assert RobotModel.from_dict(m.to_dict()) == m
     with pytest.raises(ConfigError, match=r"robot\.inflation.*-1"):
-        parse_robot({"inflation": -1})
+        RobotModel.from_dict({"inflation": -1})

@@ -288,7 +288,7 @@ def check_episode(ep, name, sc):
     # the robot moved with the recorded (clipped) velocities
     np.testing.assert_allclose(ep.positions[1:], ep.positions[:-1] + ep.velocities * dt,
                                atol=1e-12)
-    speed = ep.scenario.robot.max_speed
+    speed = ep.scenario.robot.max_speed_mps
     assert np.all(np.hypot(*ep.velocities.T) <= speed * (1 + 1e-12))
     assert ep.path_length_m == pytest.approx(path_length(ep.positions))
     assert ep.min_distance_m == min(ep.min_static_clearance_m, ep.min_obstacle_distance_m)

@@ -10,6 +10,7 @@ from pathfuse.metrics import segment_clearances
 from pathfuse.planners.registry import get_planner, make_params
 from pathfuse.planners.run import start_online
 from pathfuse.problem import Problem
+from pathfuse.robot import RobotModel
 from pathfuse.world import World
 from pathfuse.world.generate import generate_scenarios
 
@@ -25,7 +26,7 @@ def _controller(sc, **params):
     world = World(sc)
     world.reset(0)
     spec = get_planner("fusion")
-    pb = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius, robot=world.robot)
+    pb = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius_m, robot=world.robot)
     return start_online(spec, pb, make_params(spec, params), world.dt, world.max_speed)
 
 
@@ -33,7 +34,7 @@ def test_the_window_is_used_only_on_a_diff_drive_robot_and_can_be_switched_off()
     sc = _scenarios(1)[0]
     assert _controller(sc)._window is not None
     assert _controller(sc, velocity_space=False)._window is None
-    holo = sc.replace(robot=sc.robot.__class__(radius=sc.robot.radius))
+    holo = sc.replace(robot=RobotModel(radius_m=sc.robot.radius_m))
     assert _controller(holo)._window is None
 
 
@@ -55,7 +56,7 @@ def test_streamline_looks_ahead_without_moving_the_fusion():
     assert line[0].tolist() == obs.position.tolist()
     steps = np.hypot(*np.diff(line[1:], axis=0).T)
     assert steps.max() <= ctrl.step_m + 1e-9  # one move of max_speed x dt each
-    assert segment_clearances(sc.grid, line[1:]).min() >= sc.robot.radius
+    assert segment_clearances(sc.grid, line[1:]).min() >= sc.robot.radius_m
 
 
 def test_static_maps_reached_without_collision():

@@ -124,7 +124,7 @@ def _independent_static_gap(ep, n=20):
     pts = [ep.positions[0]]
     for k in range(ep.n_ticks):
         for t in np.linspace(ep.scenario.dt / n, ep.scenario.dt, n):
-            if ep.scenario.robot.model == "diff-drive":
+            if ep.scenario.robot.is_diff_drive:
                 x, y, _ = unicycle_pose(*ep.positions[k], ep.headings[k], *ep.commands[k], t)
             else:
                 x, y = ep.positions[k] + ep.commands[k] * t

@@ -65,7 +65,7 @@ def _seg_box(a, b, box):
 def _independent_min_gaps(ep):
     """Least gap to the discs and to the static map, sampling every tick 50 times."""
     sc = ep.scenario
-    r = sc.robot.radius
+    r = sc.robot.radius_m
     t = np.linspace(0.0, 1.0, 51)[:, None, None]
     p = ep.positions[:-1][None] + t * (ep.positions[1:] - ep.positions[:-1])[None]  # (S, T, 2)
     disc = math.inf
@@ -95,8 +95,8 @@ def _drive(doc, planner, params=None, seed=None):
     spec = get_planner(planner)
     world = World(sc)
     obs = world.reset(seed)
-    ctrl = start_online(spec, Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius),
-                        make_params(spec, params), sc.dt, sc.robot.max_speed)
+    ctrl = start_online(spec, Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius_m),
+                        make_params(spec, params), sc.dt, sc.robot.max_speed_mps)
     positions = [obs.position]
     while ctrl.failure is None:
         obs, term, trunc, _ = world.step(ctrl.act(obs))
@@ -253,7 +253,7 @@ def test_episode_record_is_consistent_and_json_ready():
     assert ep.global_path is not None and ep.global_path[0].tolist() == [1.0, 1.0]
     # the global path is the waypoints of A* on the robot's c-space (global_astar.route)
     sc = ep.scenario
-    assert np.array_equal(ep.global_path, route(sc.grid, sc.start, sc.goal, sc.robot.radius))
+    assert np.array_equal(ep.global_path, route(sc.grid, sc.start, sc.goal, sc.robot.radius_m))
     assert ep.path_updates[0][0] == 0 and ep.path_updates[0][1] is ep.global_path
     if ep.reached:
         assert ep.time_to_goal_s == pytest.approx(ep.times[-1])
@@ -393,10 +393,10 @@ def test_planners_get_the_static_context_and_current_observations_only():
         {"grid", "start", "goal", "robot_radius_m", "budget", "start_cell", "goal_cell",
          "clearance_m", "robot"}
     pb = spy.problem
-    assert pb.robot == sc.robot.to_model() and pb.clearance_m == sc.robot.to_model().clearance_m
+    assert pb.robot is sc.robot and pb.clearance_m == sc.robot.clearance_m
     assert pb.grid is sc.grid and pb.start == sc.start and pb.goal == sc.goal
-    assert pb.robot_radius_m == sc.robot.radius
-    assert (spy.dt, spy.max_speed, spy.online, spy.plan) == (sc.dt, sc.robot.max_speed, True,
+    assert pb.robot_radius_m == sc.robot.radius_m
+    assert (spy.dt, spy.max_speed, spy.online, spy.plan) == (sc.dt, sc.robot.max_speed_mps, True,
                                                              None)
     assert all(isinstance(o, Observation) for o in spy.seen)
     assert [o.tick for o in spy.seen] == list(range(ep.n_ticks))

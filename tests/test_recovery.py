@@ -98,9 +98,7 @@ def test_the_switch():
     assert RobotModel().recovery and RobotModel.diff_drive().recovery
     with pytest.raises(ConfigError, match=r"robot\.recovery"):
         RobotModel(recovery="yes")  # type: ignore[arg-type]
-    from pathfuse.world.robot import parse_robot
-
-    assert parse_robot({"recovery": False}).to_model().recovery is False
+    assert RobotModel.from_dict({"recovery": False}).recovery is False
 
 
 # a wall with one door: 0.75 m wide for a 0.4 m robot

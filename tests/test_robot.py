@@ -19,7 +19,6 @@ from pathfuse.sweep import (
     unicycle_pose,
 )
 from pathfuse.world import World, load_scenario
-from pathfuse.world.robot import RobotSpec
 
 ONLINE = [n for n in planner_names() if get_planner(n).online]
 
@@ -163,11 +162,11 @@ def test_a_diff_drive_robot_cutting_a_corner_on_an_arc_collides():
     assert term and info["collision"] == "static" and info["static_gap"] < 0
 
 
-def test_robot_model_and_spec_round_trip():
+def test_robot_model_and_block_round_trip():
     m = RobotModel.diff_drive(radius_m=0.3, max_speed_mps=2.0, clearance_m=0.1)
     assert m.max_accel_mps2 == DIFF_DRIVE_DEFAULTS["max_accel_mps2"]
-    assert RobotSpec.from_model(m).to_model() == m
-    assert RobotSpec().to_model() == RobotModel()
+    assert RobotModel.from_dict(m.to_dict()) == m
+    assert RobotModel.from_dict(None) == RobotModel.from_dict({}) == RobotModel()
     sc = load_scenario({"map": {"rows": ["...."]}, "start": [0.5, 0.5], "goal": [3.5, 0.5],
                         "robot": {"model": "diff-drive", "max_yaw_rate": 1.0}})
     assert load_scenario(sc.to_dict()).robot == sc.robot

@@ -263,9 +263,9 @@ def _drive(doc: dict, planner: str, params: dict | None = None):
     world = World(sc)
     obs = world.reset()
     rb = world.robot
-    ctrl = start_online(spec, Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius,
+    ctrl = start_online(spec, Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius_m,
                                              robot=rb),
-                        make_params(spec, params), sc.dt, sc.robot.max_speed)
+                        make_params(spec, params), sc.dt, sc.robot.max_speed_mps)
     event = None
     for _ in range(sc.n_steps):
         obs, term, trunc, info = world.step(ctrl.command(obs))

@@ -63,13 +63,13 @@ def test_base_and_files_load():
     sc = load_scenario(BASE)
     assert [type(o) for o in sc.obstacles] == [LinearObstacle, PatrolObstacle,
                                                RandomWalkObstacle]
-    assert sc.n_steps == 300 and sc.robot.sensing_radius == 3.0
+    assert sc.n_steps == 300 and sc.robot.sensing_radius_m == 3.0
     m = load_scenario(DATA / "minimal.yaml")
-    assert (m.dt, m.time_limit, m.goal_tolerance, m.robot.radius, m.planner.name) == \
+    assert (m.dt, m.time_limit, m.goal_tolerance, m.robot.radius_m, m.planner.name) == \
         (0.1, 60.0, 0.25, 0.2, "fusion")
     assert m.name == "minimal" and m.obstacles == ()
     f = load_scenario(DATA / "full.yaml")
-    assert (f.dt, f.seed, f.robot.max_speed, f.planner.name) == (0.05, 9, 0.8, "astar-replan")
+    assert (f.dt, f.seed, f.robot.max_speed_mps, f.planner.name) == (0.05, 9, 0.8, "astar-replan")
     assert f.planner.params == {"replan_period_s": 0.5, "margin_m": 0.1}
     assert f.obstacles[2].heading == 1.0 and f.obstacles[1].loop is False
     # the older name of the astar planner still loads, as the canonical name
@@ -113,7 +113,8 @@ MALFORMED = [
     ("robot.max_accel", 0, "robot.max_accel: must be a number > 0"),
     ("robot.max_yaw_rate", "fast", "robot.max_yaw_rate: must be a number > 0"),
     ("robot.min_speed", 0.5, "robot.min_speed: must be a number <= 0"),
-    ("robot.min_speed", -0.5, "robot.min_speed: only a diff-drive robot reverses"),
+    ("robot.min_speed", -0.5, "robot.min_speed: must be 0 for a holonomic robot (only a "
+                             "diff-drive robot reverses), got -0.5"),
     ("robot.clearance", -0.1, "robot.clearance: must be a number >= 0"),
     ("obstacles", {"a": 1}, "obstacles: must be a list"),
     ("obstacles[0]", 5, "obstacles[0]: must be a mapping"),
@@ -277,7 +278,7 @@ def test_generator_is_deterministic_and_places_discs_clear(placement):
     kinds = set()
     for sc in scs:
         assert len(sc.obstacles) == 5
-        r = sc.robot.radius
+        r = sc.robot.radius_m
         for ob in sc.obstacles:
             kinds.add(ob.kind)
             speed = ob.speed if not isinstance(ob, LinearObstacle) else float(np.hypot(

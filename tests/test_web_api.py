@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 with warnings.catch_warnings():  # starlette suggests httpx2, a fork; httpx works
     warnings.simplefilter("ignore")
@@ -557,6 +558,22 @@ def test_export_runs_unchanged_in_pathfuse_simulate(client, capsys, tmp_path, ma
     assert cli["path_length_m"] == pytest.approx(ep["path_length_m"])
     r = client.post("/api/scenario/export", json={"scenario": _scene(dt=0)})
     assert r.status_code == 400 and r.json()["error"].startswith("scenario.dt: must be")
+
+
+def test_export_writes_the_robot_keys_set_and_replays_exactly(client, capsys, tmp_path):
+    robot = {"model": "diff-drive", "max_yaw_rate": 1.5}          # the rest unset
+    scene = _scene(robot=robot, planner={"name": "dwa", "params": {}})
+    ep = client.post("/api/simulate", json={"scenario": scene}).json()
+    d = client.post("/api/scenario/export", json={"scenario": scene}).json()
+    assert yaml.safe_load(d["yaml"])["robot"] == robot
+    path = tmp_path / d["filename"]
+    path.write_text(d["yaml"])
+    from pathfuse.world import load_scenario
+
+    assert load_scenario(path).robot == pathfuse.RobotModel.from_dict(robot)
+    cli = cli_json(capsys, "simulate", str(path), "--json", "--trajectories")
+    assert cli["positions"] == ep["positions"] and cli["commands"] == ep["commands"]
+    assert ep["robot"] == {"radius": 0.2, "max_speed": 1.0, "sensing_radius": 3.0}
 
 
 def test_scenario_uploads(client):

@@ -533,7 +533,7 @@ def _clearance_at(sc: Any, x: float, y: float, discs: np.ndarray | None,
     from pathfuse.world.world import STATIC_CLEARANCE_CAP_M
 
     g = sc.grid
-    radius = float(sc.robot.radius)
+    radius = float(sc.robot.radius_m)
     gap = float(segment_static_distance(
         g.occupied, float(g.origin[0]), float(g.origin[1]), float(g.resolution), x, y, x, y,
         radius + STATIC_CLEARANCE_CAP_M)) - radius

@@ -304,9 +304,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     _warm_with_notice(str(choice["name"]), world=True)
     robot = None
     if args.robot:
-        from dataclasses import asdict
-
-        robot = {**asdict(sc.robot), **_robot_block(args.robot)}
+        robot = {**sc.robot.to_dict(), **_robot_block(args.robot)}
     ep = simulate(sc, planner=choice, seed=args.seed, robot=robot)
     anim = None
     if out is not None:

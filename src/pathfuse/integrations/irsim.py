@@ -84,7 +84,7 @@ import numpy as np
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import Controller
 from pathfuse.result import ConfigError, Status
-from pathfuse.robot import RobotModel
+from pathfuse.robot import FIELDS, RobotModel
 
 __all__ = ["IrsimController", "IrsimScene", "read_scene", "rasterise_static", "robot_model",
            "moving_objects", "import_irsim", "make_env", "example_worlds_dir",
@@ -326,11 +326,10 @@ def robot_model(obj: Any, sensing_radius_m: float = DEFAULT_SENSING_RADIUS_M,
         kw.update(max_speed_mps=float(min(vmax[0], vmax[1], -vmin[0], -vmin[1])),
                   max_accel_mps2=float(min(acce[0], acce[1])))
         base = RobotModel
-    names = set(RobotModel.__dataclass_fields__)
     for k in overrides:
-        if k not in names:
+        if k not in FIELDS:
             raise ConfigError(f"robot_overrides.{k}: not a field of pathfuse.RobotModel "
-                              f"({', '.join(sorted(names - {'kind'}))})")
+                              f"({', '.join(sorted(set(FIELDS) - {'kind'}))})")
     return base(**{**kw, **overrides})
 
 

@@ -187,16 +187,16 @@ class DynamicConfig:
             make_online_params(get_online_planner(n), p, key=f"params.{n}")
         if not isinstance(self.robot, Mapping):
             raise ConfigError(f"robot: must be a robot block {{key: value}}, got {self.robot!r}")
-        from pathfuse.world.robot import parse_robot
+        from pathfuse.robot import RobotModel
 
-        parse_robot(dict(self.robot))
+        RobotModel.from_dict(dict(self.robot))
         object.__setattr__(self, "robot", dict(self.robot))
 
     def robot_label(self) -> str:
         """The robot in words, for reports."""
-        from pathfuse.world.robot import parse_robot
+        from pathfuse.robot import RobotModel
 
-        rb = parse_robot(dict(self.robot) or None).to_model()
+        rb = RobotModel.from_dict(dict(self.robot))
         text = (f"robot radius {rb.radius_m:g} m at {rb.max_speed_mps:g} m/s with "
                 f"{rb.sensing_radius_m:g} m sensing, {rb.kind}")
         if rb.is_diff_drive:

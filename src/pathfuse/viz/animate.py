@@ -242,10 +242,10 @@ class _EpisodeRenderer:
         self.robot_trail = robot_trail
         (self.trail,) = ax.plot([], [], "-", color="#d62728", lw=1.3, zorder=6)
         add(self.trail)
-        self.sense = add(Circle(tuple(self.pos[0]), sc.robot.sensing_radius, fill=False,
+        self.sense = add(Circle(tuple(self.pos[0]), sc.robot.sensing_radius_m, fill=False,
                                 ec="#d62728", lw=0.8, ls="--", alpha=0.6, zorder=6))
         ax.add_patch(self.sense)
-        self.robot = add(Circle(tuple(self.pos[0]), max(sc.robot.radius, 0.02), fc="#d62728",
+        self.robot = add(Circle(tuple(self.pos[0]), max(sc.robot.radius_m, 0.02), fc="#d62728",
                                 ec="k", lw=0.8, zorder=7))
         ax.add_patch(self.robot)
         (self.mark,) = ax.plot([], [], "X", color="#ff0000", mec="k", ms=14, zorder=9)

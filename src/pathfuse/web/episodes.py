@@ -84,11 +84,16 @@ def simulate_request(store: MapStore, body: Any, limits: Limits) -> dict[str, An
     d = ep.to_dict(trajectories=True)
     d["sensed"] = ep.sensed.astype(int).tolist()
     d["path_updates"] = [{"tick": int(t), "path": p.tolist()} for t, p in ep.path_updates]
-    d["robot"] = {"radius": sc.robot.radius, "max_speed": sc.robot.max_speed,
-                  "sensing_radius": sc.robot.sensing_radius}
+    d["robot"] = _robot_form(sc.robot)
     d["start"], d["goal"] = list(sc.start), list(sc.goal)
     d["goal_tolerance"] = sc.goal_tolerance
     return d
+
+
+def _robot_form(robot: Any) -> dict[str, float]:
+    """The robot's values the page shows (set or not): radius, speed, sensing radius."""
+    return {"radius": robot.radius_m, "max_speed": robot.max_speed_mps,
+            "sensing_radius": robot.sensing_radius_m}
 
 
 def export_yaml(sc: Any) -> str:
@@ -120,6 +125,7 @@ def scenario_json(store: MapStore, sc: Any) -> dict[str, Any]:
     e = store.add_upload(sc.grid, sc.grid.name, spec)
     d = sc.to_dict()
     d["map"] = {"id": e.id}
+    d["robot"] = {**d["robot"], **_robot_form(sc.robot)}  # the page's form shows these
     return {"scenario": d, "map": grid_to_json(sc.grid, e.id)}
 
 

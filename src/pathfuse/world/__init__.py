@@ -20,7 +20,6 @@ from pathfuse.world.episode import Episode, run_episode, simulate
 from pathfuse.world.obstacles import LinearObstacle, PatrolObstacle, RandomWalkObstacle
 from pathfuse.world.scenario import (
     PlannerChoice,
-    RobotSpec,
     Scenario,
     ScenarioError,
     load_scenario,
@@ -36,7 +35,6 @@ __all__ = [
     "Observation",
     "SensedObstacles",
     "Scenario",
-    "RobotSpec",
     "PlannerChoice",
     "ScenarioError",
     "load_scenario",

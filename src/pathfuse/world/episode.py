@@ -44,7 +44,6 @@ from pathfuse.planners.run import start_online, warm
 from pathfuse.problem import Problem
 from pathfuse.result import ConfigError, Status, path_length
 from pathfuse.robot import RobotModel
-from pathfuse.world.robot import RobotSpec, parse_robot
 from pathfuse.world.scenario import Scenario, load_scenario, resolve_planner_choice
 from pathfuse.world.world import World
 
@@ -185,12 +184,12 @@ class Episode:
 
     @property
     def robot_radius(self) -> float:
-        return self.scenario.robot.radius
+        return self.scenario.robot.radius_m
 
     @property
     def robot(self) -> RobotModel:
         """The robot's model (:class:`pathfuse.robot.RobotModel`)."""
-        return self.scenario.robot.to_model()
+        return self.scenario.robot
 
     def trajectory(self) -> np.ndarray:
         """``(T, 4)``: ``[t, x, y, yaw]`` per tick."""
@@ -222,7 +221,7 @@ class Episode:
             "mean_plan_time_s": self.mean_plan_time_s,
             "max_plan_time_s": float(self.plan_times_s.max()) if self.plan_times_s.size else 0.0,
             "setup_time_s": float(self.setup_time_s),
-            "robot_model": self.scenario.robot.model,
+            "robot_model": self.scenario.robot.kind,
         }
         soc = self.social
         if soc is not None:  # among moving discs: the social metrics (pathfuse.world.social)
@@ -311,7 +310,7 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
     cfg = _params_of(spec, params)
     scenario = load_scenario(scenario)
     if robot is not None:
-        scenario = scenario.replace(robot=_robot_spec(robot))
+        scenario = scenario.replace(robot=_robot(robot))
     world = World(scenario)
     sc = world.scenario
     model = world.robot
@@ -328,11 +327,11 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
     positions[0] = obs.position
     sensed[0, obs.obstacles.ids] = True
 
-    problem = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius,
+    problem = Problem.create(sc.grid, sc.start, sc.goal, sc.robot.radius_m,
                              clearance_m=model.clearance_m, robot=model)
     _warm(spec, model, cfg)
     t0 = time.perf_counter()
-    ctrl: Controller = start_online(spec, problem, cfg, float(sc.dt), float(sc.robot.max_speed))
+    ctrl: Controller = start_online(spec, problem, cfg, float(sc.dt), float(sc.robot.max_speed_mps))
     setup = time.perf_counter() - t0
     path_updates: list[tuple[int, np.ndarray]] = []
     last_path = ctrl.global_path
@@ -466,12 +465,10 @@ def stored_shield_counts(metrics: Mapping[str, Any]) -> dict[str, int | None]:
     return out
 
 
-def _robot_spec(robot: Any) -> RobotSpec:
-    if isinstance(robot, RobotSpec):
-        return robot
+def _robot(robot: Any) -> RobotModel:
     if isinstance(robot, RobotModel):
-        return RobotSpec.from_model(robot)
-    return parse_robot(robot, ConfigError)
+        return robot
+    return RobotModel.from_dict(robot, ConfigError)
 
 
 def simulate(scenario: Any, planner: Any = None, seed: int | None = None,

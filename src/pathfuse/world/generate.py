@@ -49,6 +49,7 @@ from pathfuse.grid import GridMap
 from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.planners.globals.astar import route as global_route
 from pathfuse.result import ConfigError
+from pathfuse.robot import RobotModel
 from pathfuse.sweep import segment_static_distance
 from pathfuse.validate import short as _shown
 from pathfuse.world.obstacles import (
@@ -57,8 +58,7 @@ from pathfuse.world.obstacles import (
     PatrolObstacle,
     RandomWalkObstacle,
 )
-from pathfuse.world.robot import parse_robot
-from pathfuse.world.scenario import RobotSpec, Scenario, ScenarioError, resolve_planner_choice
+from pathfuse.world.scenario import Scenario, ScenarioError, resolve_planner_choice
 
 __all__ = ["generate_scenarios", "KINDS", "PLACEMENTS"]
 
@@ -186,7 +186,7 @@ def generate_scenarios(
     kinds: Sequence[str] = KINDS,
     radius_range: Sequence[float] = (0.2, 0.4),
     placement: str = "route",
-    robot: RobotSpec | Mapping[str, Any] | None = None,
+    robot: RobotModel | Mapping[str, Any] | None = None,
     dt: float = 0.1,
     time_limit: float = 60.0,
     goal_tolerance: float = 0.25,
@@ -222,8 +222,8 @@ def generate_scenarios(
         Disc radii are drawn from it.
     placement : {"route", "uniform"}
         See the module docstring.
-    robot : RobotSpec or mapping, optional
-        Default ``RobotSpec()`` (radius 0.2 m, 1 m/s, sensing 3 m, holonomic);
+    robot : RobotModel or mapping, optional
+        Default ``RobotModel()`` (radius 0.2 m, 1 m/s, sensing 3 m, holonomic);
         a mapping is read as a scenario's ``robot:`` block.
     dt, time_limit, goal_tolerance : float
         As in a scenario file.
@@ -261,8 +261,8 @@ def generate_scenarios(
                           f"got {_shown(placement)}")
     check_body_ticks(time_limit, dt, moving)  # before placing any disc
     if isinstance(robot, Mapping):
-        robot = parse_robot(dict(robot), ConfigError)
-    robot = robot or RobotSpec()
+        robot = RobotModel.from_dict(dict(robot), ConfigError)
+    robot = robot or RobotModel()
     choice = resolve_planner_choice(planner)
     fixed_grid: GridMap | None = None
     fixed_spec: Any = None
@@ -285,8 +285,8 @@ def generate_scenarios(
             g = np.array(PAPER_GOAL if goal is None else goal, dtype=np.float64)
         else:
             grid, mspec = fixed_grid, fixed_spec
-            s, g = _start_goal(rng, grid, robot.radius, start, goal)
-        route = global_route(grid, s, g, robot.radius)
+            s, g = _start_goal(rng, grid, robot.radius_m, start, goal)
+        route = global_route(grid, s, g, robot.radius_m)
         obstacles: list[ObstacleSpec] = []
         for j in range(int(moving)):
             for _ in range(_ATTEMPTS):
@@ -294,7 +294,7 @@ def generate_scenarios(
                 ob = _draw_obstacle(rng, grid, kind, float(rng.uniform(v_lo, v_hi)),
                                     float(rng.uniform(r_lo, r_hi)), route, placement,
                                     ob_seed=int(rng.integers(0, 2**31 - 1)))
-                if _valid(grid, ob, s, g, robot.radius, min_start_gap_m, min_goal_gap_m):
+                if _valid(grid, ob, s, g, robot.radius_m, min_start_gap_m, min_goal_gap_m):
                     obstacles.append(ob)
                     break
             else:

@@ -45,7 +45,7 @@ Examples
 >>> sc = load_scenario({"map": {"rows": ["......", "......", "......"]},
 ...                     "start": [0.5, 1.5], "goal": [5.5, 1.5],
 ...                     "obstacles": [{"position": [3, 0.5], "velocity": [0, 0.4]}]})
->>> sc.robot.max_speed, sc.n_steps, sc.obstacles[0].kind
+>>> sc.robot.max_speed_mps, sc.n_steps, sc.obstacles[0].kind
 (1.0, 600, 'linear')
 >>> load_scenario({"map": {"rows": ["..."]}, "start": [0.5, 0.5], "goal": [2.5, 0.5],
 ...                "dt": "fast"})
@@ -71,6 +71,7 @@ from pathfuse import validate
 from pathfuse.grid import GridMap
 from pathfuse.limits import MAX_SEED, LimitError, env_name, limit
 from pathfuse.result import ConfigError, MapFormatError, PathfuseError
+from pathfuse.robot import RobotModel
 from pathfuse.sweep import segment_static_distance
 from pathfuse.validate import short as _shown
 from pathfuse.world.obstacles import (
@@ -80,11 +81,9 @@ from pathfuse.world.obstacles import (
     RandomWalkObstacle,
 )
 from pathfuse.world.perturb import Perturbation, parse_perturb, perturb_obstacles
-from pathfuse.world.robot import RobotSpec, parse_robot
 
 __all__ = [
     "Scenario",
-    "RobotSpec",
     "PlannerChoice",
     "ScenarioError",
     "load_scenario",
@@ -133,8 +132,10 @@ class Scenario:
         The static map.
     start, goal : (float, float)
         Robot start and goal in metres.
-    robot : RobotSpec
-        Robot radius, speed limit and sensing radius.
+    robot : RobotModel
+        The robot (:class:`pathfuse.robot.RobotModel`); its
+        :attr:`~pathfuse.robot.RobotModel.explicit` fields are the ``robot:`` keys the
+        scenario sets, and the only ones :meth:`to_dict` writes.
     dt : float
         Tick length in seconds.
     time_limit : float
@@ -164,7 +165,7 @@ class Scenario:
     grid: GridMap
     start: tuple[float, float]
     goal: tuple[float, float]
-    robot: RobotSpec = field(default_factory=RobotSpec)
+    robot: RobotModel = field(default_factory=RobotModel)
     dt: float = 0.1
     time_limit: float = 60.0
     goal_tolerance: float = 0.25
@@ -231,7 +232,7 @@ class Scenario:
             "map": mspec,
             "start": list(self.start),
             "goal": list(self.goal),
-            "robot": dataclasses.asdict(self.robot),
+            "robot": self.robot.to_dict(),
             "dt": self.dt,
             "time_limit": self.time_limit,
             "goal_tolerance": self.goal_tolerance,
@@ -295,9 +296,6 @@ def _check_scene(sc: Scenario) -> None:
     _num(sc.goal_tolerance, "goal_tolerance", gt=0)
     _num(sc.stall_time, "stall_time", ge=0)
     _num(sc.stall_radius, "stall_radius", gt=0)
-    _num(sc.robot.radius, "robot.radius", ge=0)
-    _num(sc.robot.max_speed, "robot.max_speed", gt=0)
-    _num(sc.robot.sensing_radius, "robot.sensing_radius", gt=0)
     # the world keeps every disc's trajectory for the whole episode: bound ticks x bodies
     ticks = sc.time_limit / sc.dt
     steps = ticks * (1 + len(sc.obstacles))
@@ -308,16 +306,10 @@ def _check_scene(sc: Scenario) -> None:
             f"the robot and {len(sc.obstacles)} moving discs ({steps:.3g} body-ticks) is above "
             f"the limit of {cap} (MAX_TICKS; set the environment variable "
             f"{env_name('MAX_TICKS')} to raise it)")
-    if not isinstance(sc.robot, RobotSpec):
-        raise ScenarioError(f"robot: must be a RobotSpec, got {type(sc.robot).__name__}")
-    if sc.robot.model == "holonomic" and sc.robot.min_speed != 0:
-        raise ScenarioError(f"robot.min_speed: only a diff-drive robot reverses; got "
-                            f"{sc.robot.min_speed!r} for a holonomic one")
-    try:
-        sc.robot.to_model()  # the model and its limits
-    except ConfigError as exc:
-        raise ScenarioError(str(exc)) from None
-    r = sc.robot.radius
+    if not isinstance(sc.robot, RobotModel):  # checked when it was built
+        raise ScenarioError(f"robot: must be a pathfuse.RobotModel, got "
+                            f"{type(sc.robot).__name__}")
+    r = sc.robot.radius_m
     _check_point(sc.grid, sc.start, r, "start", "the robot")
     _check_point(sc.grid, sc.goal, r, "goal", "the robot")
     for i, ob in enumerate(sc.obstacles):
@@ -353,7 +345,7 @@ def _check_disc(sc: Scenario, i: int, ob: ObstacleSpec) -> None:
             else f"{key}.position"
         _check_point(sc.grid, ob.position, ob.radius, pkey, "the disc")
     gap = math.hypot(ob.position[0] - sc.start[0], ob.position[1] - sc.start[1]) \
-        - ob.radius - sc.robot.radius
+        - ob.radius - sc.robot.radius_m
     if gap < 0:
         raise ScenarioError(f"{key}: overlaps the robot at the start (by {-gap:.3g} m)")
 
@@ -518,7 +510,7 @@ def scenario_from_dict(doc: Mapping[str, Any], base_dir: str | os.PathLike[str] 
         grid=grid,
         start=_point(doc["start"], "start"),
         goal=_point(doc["goal"], "goal"),
-        robot=parse_robot(doc.get("robot"), ScenarioError),
+        robot=RobotModel.from_dict(doc.get("robot"), ScenarioError),
         dt=_num(doc.get("dt", 0.1), "dt", gt=0),
         time_limit=_num(doc.get("time_limit", 60.0), "time_limit", gt=0),
         goal_tolerance=_num(doc.get("goal_tolerance", 0.25), "goal_tolerance", gt=0),

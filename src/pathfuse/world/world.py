@@ -12,12 +12,12 @@ depending on Gymnasium and without a reward)::
 
 The action
 ----------
-It depends on the robot's model (``robot.model``, :mod:`pathfuse.robot`):
+It depends on the robot's model (``robot.kind``, :class:`pathfuse.robot.RobotModel`):
 
 * holonomic (the default): a **velocity** ``(vx, vy)`` in m/s, held for one
-  tick of ``dt`` seconds.  Its norm is clipped to ``robot.max_speed``
-  (direction kept) and, with ``robot.max_accel`` set, its change to
-  ``max_accel * dt``; the robot moves in a straight line from ``p`` to
+  tick of ``dt`` seconds.  Its norm is clipped to ``robot.max_speed_mps``
+  (direction kept) and, with ``robot.max_accel_mps2`` set, its change to
+  ``max_accel_mps2 * dt``; the robot moves in a straight line from ``p`` to
   ``p + v * dt``.
 * diff-drive: ``(v, omega)``, the linear speed along the heading and the yaw
   rate, each clipped to its limit and to the window its acceleration limit
@@ -60,7 +60,7 @@ tick count reaches ``ceil(time_limit / dt)``.
 Sensing
 -------
 The observation holds the robot's state, the goal and the moving discs
-whose surface lies within ``robot.sensing_radius`` of the robot's centre
+whose surface lies within ``robot.sensing_radius_m`` of the robot's centre
 *now*: their ids, positions, current velocities (the velocity they had over
 the last tick, or their initial velocity at tick 0) and radii.  Obstacle
 trajectories are precomputed at :meth:`World.reset` (they are a pure
@@ -192,10 +192,10 @@ class World:
         self._res = float(g.resolution)
         self.dt = float(sc.dt)
         self.n_steps = sc.n_steps
-        self.robot = sc.robot.to_model()
-        self.radius = float(sc.robot.radius)
-        self.max_speed = float(sc.robot.max_speed)
-        self.sensing_radius = float(sc.robot.sensing_radius)
+        self.robot = sc.robot
+        self.radius = float(sc.robot.radius_m)
+        self.max_speed = float(sc.robot.max_speed_mps)
+        self.sensing_radius = float(sc.robot.sensing_radius_m)
         self.diff_drive = self.robot.is_diff_drive
         self.goal = np.array(sc.goal, dtype=np.float64)
         self.obstacle_radii = np.array([ob.radius for ob in sc.obstacles], dtype=np.float64)

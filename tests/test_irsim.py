@@ -117,8 +117,9 @@ def test_robot_model_follows_irsim_limits(tmp_path):
     env = make_env(_world(tmp_path, BOX + ROBOT_DIFF))
     sc = read_scene(env, sensing_radius_m=4.0, robot_overrides={"clearance_m": 0.1})
     rb = sc.robot
-    assert (rb.kind, rb.radius_m, rb.max_speed_mps, rb.max_accel_mps2) == \
-        ("diff-drive", 0.25, 1.0, 2.0)
+    assert (rb.kind, rb.max_speed_mps, rb.max_accel_mps2) == ("diff-drive", 1.0, 2.0)
+    # planned with IR-SIM's radius grown by the Euler step's largest gap over a stop
+    assert rb.radius_m == 0.25 + sc.euler_margin_m and 0.02 < sc.euler_margin_m < 0.025
     assert (rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2, rb.min_speed_mps) == (2.0, 4.0, 0.0)
     assert (rb.sensing_radius_m, rb.clearance_m) == (4.0, 0.1)
     assert sc.goal == (5.3, 2.0) and sc.goal_tolerance_m == 0.3 and sc.dt_s == 0.1
@@ -222,8 +223,8 @@ def test_shipped_worlds_read(tmp_path):
         assert spec.position_m > 0 and spec.speed_frac > 0 and spec.time_limit_s >= 40
         env = make_env(EXAMPLES / f"{n}.yaml")
         sc = read_scene(env)
-        assert (sc.robot.kind, sc.robot.radius_m, sc.robot.max_speed_mps) == \
-            ("diff-drive", 0.25, 1.0)
+        assert (sc.robot.kind, sc.robot.radius_m - sc.euler_margin_m, sc.robot.max_speed_mps) \
+            == ("diff-drive", 0.25, 1.0)
         assert sc.grid.is_free(np.array([sc.start, sc.goal])).all()
 
 
@@ -338,3 +339,48 @@ def test_experiment_irsim_entries_key_by_contents_and_name_bad_keys(tmp_path):
     ]:
         with pytest.raises(ConfigError, match=msg):
             experiment_from_dict({"maps": maps, "planners": planners}, tmp_path / "e.yaml")
+
+
+# --------------------------------------------------------------------------- IR-SIM's Euler step
+def test_euler_margin_bounds_irsims_step_against_the_arcs_over_every_stop():
+    """From any command in the limits, the stop the shield relies on (speed and turn rate
+    to zero at their acceleration limits), stepped by IR-SIM's own forward-Euler kinematics,
+    never leaves pathfuse's exact arcs by more than euler_margin_m."""
+    from irsim.lib.algorithm.kinematics import differential_kinematics
+
+    from pathfuse.integrations.irsim import euler_margin_m
+    from pathfuse.robot import RobotModel
+    from pathfuse.sweep import unicycle_pose
+
+    rng = np.random.default_rng(3)
+    worst_ratio = 0.0
+    for _ in range(200):
+        vmax, wmax = rng.uniform(0.2, 2.0), rng.uniform(0.5, 3.0)
+        a, alpha, dt = rng.uniform(0.5, 4.0), rng.uniform(1.0, 8.0), rng.choice([0.05, 0.1, 0.2])
+        rb = RobotModel.diff_drive(radius_m=0.25, max_speed_mps=vmax, max_accel_mps2=a,
+                                   max_yaw_rate_radps=wmax, max_yaw_accel_radps2=alpha)
+        bound = euler_margin_m(rb, dt)
+        v, w = rng.uniform(0, vmax), rng.uniform(-wmax, wmax)
+        s = np.array([[0.0], [0.0], [rng.uniform(-3, 3)]])
+        x, y, th = 0.0, 0.0, float(s[2, 0])
+        dev = 0.0
+        for _ in range(1000):
+            s = differential_kinematics(s, np.array([[v], [w]]), dt)
+            x, y, _th = unicycle_pose(x, y, th, v, w, dt)
+            th = float(s[2, 0])  # the headings agree; IR-SIM wraps its own
+            dev = max(dev, math.hypot(float(s[0, 0]) - x, float(s[1, 0]) - y))
+            if v == 0.0 and w == 0.0:
+                break
+            v = max(0.0, v - a * dt)
+            w = math.copysign(max(0.0, abs(w) - alpha * dt), w)
+        assert dev <= bound + 1e-12
+        worst_ratio = max(worst_ratio, dev / bound)
+    assert worst_ratio > 0.5  # the bound is not loose by much on the worst draws
+
+
+def test_dwa_in_irsim_does_not_drive_into_a_wall():
+    """Regression: dwa grazed the corridor's wall and IR-SIM's Euler step took it 1 mm in
+    (corridor_head_on, seed 3: a static collision, the robot moving)."""
+    ep = run_irsim_episode(Path(example_worlds_dir()) / "corridor_head_on.yaml", "dwa", 3)
+    assert ep.collision_with != "static" and ep.collision_at_fault is not True
+

@@ -31,7 +31,9 @@ What is read once, at construction
 * **The robot**: its kinematics (``diff`` -> pathfuse's diff-drive model, the
   action ``(v, omega)``; ``omni`` -> the holonomic model, a world-frame
   velocity), radius (a non-circular robot is planned as the disc of its
-  circumscribed radius), velocity and acceleration limits (``vel_max``,
+  circumscribed radius; a diff robot's radius grown by :func:`euler_margin_m`, the
+  most IR-SIM's forward-Euler step can leave pathfuse's exact arcs over one stop, ours),
+  velocity and acceleration limits (``vel_max``,
   ``vel_min``, ``acce``; an omni robot's per-axis limits become the smaller of
   the two as a bound on the vector), start, heading and goal (its
   ``goal_threshold`` is the goal tolerance).
@@ -57,8 +59,12 @@ Examples
 >>> import pathlib
 >>> env = make_env(pathlib.Path(example_worlds_dir()) / "corridor_head_on.yaml")
 >>> ctrl = IrsimController(env, planner="fusion")
->>> ctrl.scene.kinematics, ctrl.scene.robot.radius_m, ctrl.scene.grid.resolution
-('diff', 0.25, 0.05)
+>>> ctrl.scene.kinematics, ctrl.scene.grid.resolution
+('diff', 0.05)
+>>> # planned as a disc grown by the gap between IR-SIM's Euler step and the arcs
+>>> r, m = ctrl.scene.robot.radius_m, ctrl.scene.euler_margin_m
+>>> round(r - m, 6), round(m, 3)
+(0.25, 0.022)
 >>> a = ctrl.act(env)
 >>> a.shape
 (2, 1)
@@ -353,6 +359,9 @@ class IrsimScene:
         IR-SIM's ``step_time``.
     robot_id : int
         The IR-SIM object id of the robot.
+    euler_margin_m : float
+        How much ``robot.radius_m`` was grown over IR-SIM's radius for the gap between
+        IR-SIM's Euler step and pathfuse's arcs (:func:`euler_margin_m`; 0 for omni).
     """
 
     grid: GridMap
@@ -363,6 +372,46 @@ class IrsimScene:
     kinematics: str
     dt_s: float
     robot_id: int
+    euler_margin_m: float = 0.0
+
+
+def euler_margin_m(robot: RobotModel, dt: float) -> float:
+    """How far IR-SIM's diff-drive step can leave pathfuse's prediction over one stop, m.
+
+    IR-SIM moves a diff robot by a forward-Euler step (``v dt`` along its heading, then
+    the heading turns by ``omega dt``); pathfuse's shield and controllers predict the exact
+    arc.  The headings agree after every tick; the positions differ by the gap between the
+    chord of the arc and the Euler step.  This sums that gap over the worst case the
+    shield relies on: the command's tick at full speed and full turn rate, then the stop
+    (speed and turn rate falling at their acceleration limits to zero).  The adapter plans
+    with the robot's radius grown by it, so a stop the shield found clear stays clear in
+    IR-SIM (ours).
+
+    Examples
+    --------
+    >>> rb = RobotModel.diff_drive(radius_m=0.25, max_speed_mps=1.0, max_accel_mps2=2.0,
+    ...                            max_yaw_rate_radps=2.0, max_yaw_accel_radps2=4.0)
+    >>> round(euler_margin_m(rb, 0.1), 4)
+    0.022
+    """
+    if not robot.is_diff_drive or dt <= 0.0:
+        return 0.0
+    v = max(abs(robot.max_speed_mps), abs(robot.min_speed_mps))
+    w = robot.max_yaw_rate_radps
+    a, alpha = robot.max_accel_mps2, robot.max_yaw_accel_radps2
+    if not (math.isfinite(v) and math.isfinite(w)):
+        return 0.0
+    total = 0.0
+    for _ in range(100_000):
+        h = w * dt
+        if abs(h) > 1e-12:
+            dx, dy = v / w * math.sin(h), v / w * (1.0 - math.cos(h))
+            total += math.hypot(v * dt - dx, dy)
+        if v <= 0.0 or not (math.isfinite(a) and a > 0.0):
+            break
+        v = max(0.0, v - a * dt)
+        w = max(0.0, w - alpha * dt) if math.isfinite(alpha) else 0.0
+    return total
 
 
 def read_scene(env: Any, robot: int = 0, resolution_m: float = DEFAULT_RESOLUTION_M,
@@ -375,11 +424,15 @@ def read_scene(env: Any, robot: int = 0, resolution_m: float = DEFAULT_RESOLUTIO
         raise ConfigError(f"robot {obj.name!r}: has no goal (give it goal: [x, y, theta] in "
                           "the world file)")
     model = robot_model(obj, sensing_radius_m, **dict(robot_overrides or {}))
+    step = float(_world(env).step_time)
+    margin = euler_margin_m(model, step) if obj.kinematics == "diff" else 0.0
+    if margin > 0.0:
+        model = model.replace(radius_m=model.radius_m + margin)
     grid = rasterise_static(env, resolution_m, exclude=(obj.id,))
     g = _col(goal)
     return IrsimScene(grid, (float(obj.state[0, 0]), float(obj.state[1, 0])),
                       (float(g[0]), float(g[1])), float(obj.goal_threshold), model,
-                      str(obj.kinematics), float(_world(env).step_time), int(obj.id))
+                      str(obj.kinematics), step, int(obj.id), margin)
 
 
 def moving_objects(env: Any, robot_id: int) -> list[Any]:

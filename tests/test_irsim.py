@@ -384,3 +384,13 @@ def test_dwa_in_irsim_does_not_drive_into_a_wall():
     ep = run_irsim_episode(Path(example_worlds_dir()) / "corridor_head_on.yaml", "dwa", 3)
     assert ep.collision_with != "static" and ep.collision_at_fault is not True
 
+
+def test_fusion_waits_outside_a_crossing_stream():
+    """Regression: among a stream of people crossing its corridor the fusion drove into
+    their lane and was walked into from behind (crossing_stream, seed 3); the dwell
+    critic keeps it out of the lane."""
+    world = Path(example_worlds_dir()) / "crossing_stream.yaml"
+    ep = run_irsim_episode(world, "fusion", 3, {"seed": 3})
+    assert ep.status.name == "SUCCESS" and ep.social.min_gap_m > 0.3
+    off = run_irsim_episode(world, "fusion", 3, {"seed": 3, "dwell_s": 0.0})
+    assert off.status.name == "COLLISION" and off.collision_with == "person"

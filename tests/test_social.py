@@ -125,3 +125,71 @@ def test_switch_off_is_the_planner_without_the_critics():
                                                            **({} if name == "mppi" else
                                                               {"side_weight": 0.0})}})
         np.testing.assert_array_equal(a.positions, b.positions)
+
+
+def _brute_dwell(px, py, t, q, v, rd, radius, dwell_s, personal, n=20001):
+    """The dwell critic by sampling the disc's lane finely (independent of the kernel)."""
+    u = np.linspace(0.0, 1.0, n)
+    worst = 0.0
+    for i in range(rd.shape[0]):
+        xs = q[i, 0] + v[i, 0] * (t + u * dwell_s)
+        ys = q[i, 1] + v[i, 1] * (t + u * dwell_s)
+        d = np.hypot(xs - px, ys - py)
+        k = int(np.argmin(d))
+        g = d[k] - radius - rd[i]
+        if g < personal:
+            worst = max(worst, (personal - max(g, 0.0)) / personal * (1.0 - 0.5 * u[k]))
+    return worst
+
+
+def test_dwell_shortfall_matches_a_sampled_lane():
+    from pathfuse.planners.controllers.social import dwell_shortfall
+
+    rng = np.random.default_rng(7)
+    hits = 0
+    for _ in range(300):
+        n = int(rng.integers(1, 4))
+        q = rng.uniform(-3, 3, (n, 2))
+        v = rng.uniform(-1.5, 1.5, (n, 2))
+        rd = rng.uniform(0.1, 0.4, n)
+        px, py = rng.uniform(-2, 2, 2)
+        t, dwell = float(rng.uniform(0, 2)), float(rng.uniform(0.2, 3))
+        got = dwell_shortfall(px, py, t, q, v, rd, 0.25, dwell, 0.5)
+        want = _brute_dwell(px, py, t, q, v, rd, 0.25, dwell, 0.5)
+        assert got == pytest.approx(want, abs=2e-3)
+        hits += got > 0
+    assert 30 < hits < 270  # both kinds of case were drawn
+
+
+def test_dwell_critic_is_switchable_and_off_by_default_in_dwa_and_mppi():
+    from pathfuse.planners.registry import get_planner
+
+    assert get_planner("fusion").defaults()["dwell_s"] == 1.5
+    assert get_planner("dwa").defaults()["dwell_s"] == 0.0
+    assert get_planner("mppi").defaults()["dwell_s"] == 0.0
+    f = _settings()
+    assert f[K.D_DWELL] == 0.0  # the window's settings: the fusion's default social params
+    f = _settings(dwell_s=2.0)
+    assert (f[K.D_DWELL], f[K.D_WDWELL]) == (2.0, 50.0)
+    assert _settings(dwell_s=2.0, social=False)[K.D_DWELL] == 0.0
+
+
+def test_dwell_critic_moves_dwa_out_of_a_walkers_lane():
+    """A walker far down a lane that crosses the route 2 m ahead reaches the route only
+    after the rollouts' horizon: without the dwell critic dwa drives on into the lane at
+    full speed, with it dwa slows so as not to end there."""
+    dpos = np.array([[6.0, -2.0]])
+    dvel = np.array([[0.0, 1.0]])   # up the lane x = 6, reaching the route (y = 3) in 5 s
+    drad = np.array([0.3])
+
+    def speed(**social):
+        f = _settings(**social)
+        chosen = np.zeros((1, 2))
+        a0, a1, count, _ = K.dwa_choose(HALL.occupied, f, 4.0, 3.0, 0.0, 0.8, 0.0, PTS, CUM,
+                                        0, dpos, dvel, drad, np.array([0.0]), chosen)
+        assert count > 0
+        return a0
+
+    v_off, v_on = speed(dwell_s=0.0), speed(dwell_s=3.0)
+    assert v_off == pytest.approx(1.0)
+    assert v_on < 0.8

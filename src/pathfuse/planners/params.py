@@ -203,6 +203,16 @@ class PersonalSpaceParams(Checked):
     personal_m: float = param(0.5, gt=0, le=10, unit="m",
                               help="personal space: the gap kept from moving discs where the "
                                    "space allows")
+    dwell_s: float = param(0.0, ge=0, le=30, unit="s",
+                           help="yield outside a walker's lane (ours): a rollout pays "
+                                "dwell_weight where it ends within personal_m of the lane a "
+                                "sensed disc, predicted at constant velocity, sweeps in the "
+                                "dwell_s after the rollout (the spot where the robot may have "
+                                "to stand); 0 = off")
+    dwell_weight: float = param(50.0, ge=0, le=1e6,
+                                help="weight of the dwell critic (dwell_s), times the "
+                                     "shortfall against personal_m, relative, halved for a "
+                                     "disc that reaches the spot only at the end of dwell_s")
 
 
 @dataclass(frozen=True)

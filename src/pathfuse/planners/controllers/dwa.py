@@ -202,7 +202,8 @@ class DWAController(Controller):
             p.passive_safety,
             w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
             keep_m=p.keep_m, w_social=p.social_weight if p.social else 0.0,
-            personal_m=p.personal_m, w_side=p.side_weight if p.social else 0.0)
+            personal_m=p.personal_m, w_side=p.side_weight if p.social else 0.0,
+            dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight)
         self.sides = PassingSides(p.personal_m)
         self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
         self.no_choice = 0

@@ -14,6 +14,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.planners.controllers.social import dwell_shortfall
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
 from pathfuse.sweep import (
     arc_deviation_bound,
@@ -28,8 +29,8 @@ __all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "relaxed", "set
 (D_DT, D_VMIN, D_VMAX, D_AMAX, D_WMAX, D_ALPHA, D_RADIUS, D_CLEAR, D_MARGIN, D_HORIZON,
  D_SIMDT, D_NV, D_NW, D_WPATH, D_WGOAL, D_WHEAD, D_WSPEED, D_WOBS, D_WDYN, D_RANGE,
  D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES, D_PASSIVE, D_WALIGN, D_NEAR, D_WKEEP, D_KEEP,
- D_GREF, D_WSOC, D_PERSONAL, D_WSIDE, D_TX, D_TY) = range(37)
-N_D = 37
+ D_GREF, D_WSOC, D_PERSONAL, D_WSIDE, D_TX, D_TY, D_DWELL, D_WDWELL) = range(39)
+N_D = 39
 SOFT = 0.3
 KEEP_FLOOR = 0.02
 """The keep critic's shortfall is relative to the path's gap, but to at least this (m)."""
@@ -39,7 +40,8 @@ PASSIVE_COST = 20.0
 def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
              n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
              decay, holonomic, ox, oy, res, passive=True, w_align=0.0, near_s=0.0,
-             w_keep=0.0, keep_m=0.3, w_social=0.0, personal_m=0.5, w_side=0.0):
+             w_keep=0.0, keep_m=0.3, w_social=0.0, personal_m=0.5, w_side=0.0, dwell_s=0.0,
+             w_dwell=0.0):
     """The settings array of :func:`dwa_choose`.
 
     With a safety margin (``margin > 0``) the passing-side critic is off: holding a side
@@ -51,7 +53,8 @@ def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, 
     vals = (dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
             n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
             decay, 1.0 if holonomic else 0.0, ox, oy, res, 1.0 if passive else 0.0,
-            w_align, near_s, w_keep, keep_m, np.inf, w_social, personal_m, w_side, 0.0, 0.0)
+            w_align, near_s, w_keep, keep_m, np.inf, w_social, personal_m, w_side, 0.0, 0.0,
+            dwell_s, w_dwell)
     for i, v in enumerate(vals):
         f[i] = float(v)
     return f
@@ -240,6 +243,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
     ex = x
     ey = y
     eth = th
+    tend = 0.0
     for i in range(1, n + 1):
         t = min(i * h, horizon)
         bx, by, bth = unicycle_pose(x, y, th, v, w, t)
@@ -306,6 +310,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
         ex = bx
         ey = by
         eth = bth
+        tend = t
     out[1] = 1.0 if ok else 0.0
     out[2] = 1.0 if first_ok else 0.0
     if not ok:
@@ -337,6 +342,11 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
             if dside[j] != 0.0 and sides[j, 0] != 0.0 and sides[j, 0] != dside[j] \
                     and gj < personal + 1.0:
                 side_cost = 1.0
+    dwc = 0.0
+    if n_disc > 0 and f[D_DWELL] > 0.0 and f[D_WDWELL] > 0.0:
+        # ours (the dwell critic): the robot may have to stand where the rollout ends
+        dwc = f[D_WDWELL] * dwell_shortfall(ex, ey, tend, dpos, dvel, drad, radius,
+                                            f[D_DWELL], personal)
     # the end point against the path near the progress index: its distance to the path and
     # how much path is left beyond its projection
     m = pts.shape[0]
@@ -368,7 +378,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
         obs += 10.0 * (margin - gap) / margin
     out[0] = (f[D_WPATH] * pd + f[D_WGOAL] * left + f[D_WHEAD] * he
               + f[D_WSPEED] * (f[D_VMAX] - v) / f[D_VMAX] + f[D_WOBS] * obs + f[D_WDYN] * dyn
-              + f[D_WSOC] * soc + f[D_WSIDE] * side_cost)
+              + f[D_WSOC] * soc + f[D_WSIDE] * side_cost + dwc)
     if n_align > 0:
         out[0] += walign * align / n_align
     wkeep = f[D_WKEEP] if n_disc == 0 else 0.0

@@ -142,6 +142,12 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
              "swerve and get away) or with the dynamic window as without discs")
     seed: int = param(0, ge=0, le=2**63 - 1,
                       help="seed of MPPI's sampling noise among discs (among_discs='mppi')")
+    dwell_s: float = param(1.5, ge=0, le=30, unit="s",
+                           help="yield outside a walker's lane (ours, among discs): a rollout "
+                                "pays dwell_weight where it ends within personal_m of the lane "
+                                "a sensed disc, predicted at constant velocity, sweeps in the "
+                                "dwell_s after the rollout; 0 = off (the default of dwa and "
+                                "mppi)")
     velocity_space: bool = param(True, help="diff-drive robot online: choose (v, omega) from "
                                             "the dynamic window by agreement with Algorithm "
                                             "2's move, clearance and the predicted discs "

@@ -139,7 +139,8 @@ class ForceWindow:
             p.inflation_decay_m, False, ox, oy, g.resolution, PASSIVE_WINDOW,
             w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
             keep_m=p.keep_m, w_social=sp.social_weight if sp.social else 0.0,
-            personal_m=sp.personal_m, w_side=sp.side_weight if sp.social else 0.0)
+            personal_m=sp.personal_m, w_side=sp.side_weight if sp.social else 0.0,
+            dwell_s=sp.dwell_s if sp.social else 0.0, w_dwell=sp.dwell_weight)
         self.sides = PassingSides(sp.personal_m)
         self.steps = max(1, int(math.ceil(p.horizon_s / dt)))
         """Algorithm 2's moves looked ahead each tick (the rollouts' horizon)."""
@@ -177,7 +178,8 @@ class ForceWindow:
                 waypoints = np.array([problem.start, problem.goal], dtype=np.float64)
 
             mp = MPPIParams(seed=self.seed, social=sp.social, social_weight=sp.social_weight,
-                            personal_m=sp.personal_m)
+                            personal_m=sp.personal_m, dwell_s=sp.dwell_s,
+                            dwell_weight=sp.dwell_weight)
             self._mppi = MPPIController(problem, mp, _Plan(), dt=float(dt),
                                         max_speed=self.vmax)
             self._mppi.replan_every = 0  # the fusion replans (FusionController)

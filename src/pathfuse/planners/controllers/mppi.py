@@ -291,7 +291,8 @@ class MPPIController(Controller):
             p.vy_std_mps if self.holonomic else p.wz_std_radps, self.seg_max,
             float(problem.goal[0]), float(problem.goal[1]), p.obstacle_peak_weight,
             g.resolution, min(vmax, p.slow_guide_speed_mps), p.keep_better_guide,
-            w_social=p.social_weight if p.social else 0.0, personal_m=p.personal_m)
+            w_social=p.social_weight if p.social else 0.0, personal_m=p.personal_m,
+            dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight)
         self._baseline()
         n, k = int(p.time_steps), int(p.batch_size)
         self.nominal = np.zeros((n, 2))

@@ -29,6 +29,7 @@ import math
 import numpy as np
 from numba import njit
 
+from pathfuse.planners.controllers.social import dwell_shortfall
 from pathfuse.sweep import segment_static_distance, unicycle_pose
 
 __all__ = ["mppi_optimise", "pack_mppi", "path_inflation", "N_M", "static_gap"]
@@ -37,8 +38,8 @@ __all__ = ["mppi_optimise", "pack_mppi", "path_inflation", "N_M", "static_gap"]
  M_OX, M_OY, M_XMAX, M_YMAX, M_FRES, M_TEMP, M_WCOLL, M_WOBS, M_INFL_R, M_INFL_K,
  M_WALIGN, M_WPROG, M_WGOAL, M_GOALD, M_WHEAD, M_LOOK, M_WDCOLL, M_WDPROX, M_DDECAY,
  M_WSMOOTH, M_WFWD, M_STD0, M_STD1, M_SEGMAX, M_GX, M_GY, M_PEAK, M_RES, M_SLOW,
- M_KEEP, M_WSOC, M_PERSONAL) = range(42)
-N_M = 42
+ M_KEEP, M_WSOC, M_PERSONAL, M_DWELL, M_WDWELL) = range(44)
+N_M = 44
 MARGIN_COST = 1.0
 """Inside the robot's safety margin the obstacle cost grows by this much per margin width."""
 N_FIXED = 4
@@ -49,13 +50,13 @@ def pack_mppi(dt, model_dt, vmin, vmax, amax, wmax, alpha, holonomic, radius, ma
               xmax, ymax, field_res, temperature, w_coll, w_obs, infl_radius, infl_k, w_align,
               w_prog, w_goal, goal_dist, w_head, lookahead, w_dcoll, w_dprox, disc_decay,
               w_smooth, w_fwd, std0, std1, seg_max, gx, gy, w_peak, res, slow, keep_guide,
-              w_social=0.0, personal_m=0.5):
+              w_social=0.0, personal_m=0.5, dwell_s=0.0, w_dwell=0.0):
     """The settings array of :func:`mppi_optimise`."""
     vals = (dt, model_dt, vmin, vmax, amax, wmax, alpha, 1.0 if holonomic else 0.0, radius,
             margin, ox, oy, xmax, ymax, field_res, temperature, w_coll, w_obs, infl_radius,
             infl_k, w_align, w_prog, w_goal, goal_dist, w_head, lookahead, w_dcoll, w_dprox,
             disc_decay, w_smooth, w_fwd, std0, std1, seg_max, gx, gy, w_peak, res, slow,
-            1.0 if keep_guide else 0.0, w_social, personal_m)
+            1.0 if keep_guide else 0.0, w_social, personal_m, dwell_s, w_dwell)
     f = np.zeros(N_M)
     for i, v in enumerate(vals):
         f[i] = float(v)
@@ -410,6 +411,10 @@ def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_m
                 sh = (f[M_PERSONAL] - max(dgap[i], 0.0)) / f[M_PERSONAL]
                 soc = max(soc, sh * sh)
         cost += f[M_WSOC] * soc
+    if f[M_DWELL] > 0.0 and f[M_WDWELL] > 0.0 and not hit:
+        # ours (the dwell critic): the robot may have to stand where the rollout ends
+        cost += f[M_WDWELL] * dwell_shortfall(px, py, tnow, dpos, dvel, drad, radius,
+                                              f[M_DWELL], f[M_PERSONAL])
     if goal_mode:
         cost += f[M_WGOAL] * goal / n
     else:

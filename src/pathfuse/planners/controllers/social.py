@@ -19,16 +19,27 @@ Two critics of the sampled rollouts (in :mod:`pathfuse.planners.controllers.dwa_
   the robot or no longer sensed.  The robot picks a side once instead of
   swinging between two people or in front of one.
 
-``social: false`` (a parameter of ``dwa``, ``fusion`` and ``mppi``) turns both off.
+A third critic, **dwell** (``dwell_s``, on by default in the fusion among discs, off in
+``dwa`` and ``mppi``): a rollout ends where the robot may have to stand.  Each sensed
+disc, predicted at constant velocity, sweeps a lane in the ``dwell_s`` after the
+rollout's end; a rollout ending within ``personal_m`` of that lane pays
+``dwell_weight`` times the shortfall (relative, halved for a disc that arrives only at
+the end of ``dwell_s``): :func:`dwell_shortfall`.  The robot then waits outside a
+walker's lane, not in it (a walker that does not react walks into a robot standing in
+its way).
+
+``social: false`` (a parameter of ``dwa``, ``fusion`` and ``mppi``) turns all three off.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
+from numba import njit
 
-__all__ = ["PassingSides", "disc_ids", "COMMIT_M", "BEHIND_M"]
+__all__ = ["PassingSides", "disc_ids", "dwell_shortfall", "COMMIT_M", "BEHIND_M"]
 
 COMMIT_M = 1.0
 """A disc whose predicted gap to the chosen command's rollout is below ``personal_m``
@@ -95,3 +106,43 @@ def disc_ids(obs: Any, n: int) -> np.ndarray:
     if ids is None or len(ids) != n:
         return np.arange(n)
     return np.asarray(ids)
+
+
+@njit(cache=True)
+def dwell_shortfall(px, py, t, dpos, dvel, drad, radius, dwell_s, personal_m):
+    """The dwell critic of a rollout ending at ``(px, py)`` at time ``t`` (see the module
+    docstring): over the sensed discs, the largest ``(personal_m - gap) / personal_m``
+    (gap clipped at 0) times ``1 - u / 2``, where ``gap`` is the least distance between
+    the robot's disc standing there and disc ``i`` moving on from ``dpos[i] + dvel[i] t``
+    at ``dvel[i]`` for ``dwell_s``, and ``u`` in [0, 1] is when in ``dwell_s`` it comes
+    closest.  0 when no disc comes within ``personal_m``.
+
+    Examples
+    --------
+    >>> z = np.zeros((1, 2))
+    >>> v = np.array([[0.0, 1.0]])               # a disc walking along +y at x = 3
+    >>> r = np.array([0.25])
+    >>> p = np.array([[3.0, -1.0]])
+    >>> round(dwell_shortfall(3.0, 0.0, 0.0, p, v, r, 0.25, 1.5, 0.5), 3)   # in its lane
+    0.667
+    >>> dwell_shortfall(1.5, 0.0, 0.0, p, v, r, 0.25, 1.5, 0.5)   # 1.5 m beside it
+    0.0
+    >>> dwell_shortfall(3.0, 0.0, 0.0, p, z, r, 0.25, 1.5, 0.5)   # standing 1 m away
+    0.0
+    """
+    worst = 0.0
+    for i in range(drad.shape[0]):
+        ax = dpos[i, 0] + dvel[i, 0] * t
+        ay = dpos[i, 1] + dvel[i, 1] * t
+        bx = dvel[i, 0] * dwell_s
+        by = dvel[i, 1] * dwell_s
+        l2 = bx * bx + by * by
+        u = 0.0
+        if l2 > 0.0:
+            u = min(1.0, max(0.0, ((px - ax) * bx + (py - ay) * by) / l2))
+        g = math.hypot(px - ax - u * bx, py - ay - u * by) - radius - drad[i]
+        if g < personal_m:
+            sh = (personal_m - max(g, 0.0)) / personal_m * (1.0 - 0.5 * u)
+            if sh > worst:
+                worst = sh
+    return worst

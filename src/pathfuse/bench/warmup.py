@@ -65,7 +65,7 @@ def warm_kernels(planners: Iterable[str], metrics: bool = True, world: bool = Fa
     if cold and notify is not None:
         notify(f"compiling the kernels of {_and(cold)} (first run only; cached afterwards)")
     for n in names:  # a world's robot may be a diff-drive one
-        warm(get_planner(n), diff_drive=world)
+        warm(get_planner(n), diff_drive=world, online=world)
     if metrics:
         from pathfuse.metrics_kernels import warmup
 

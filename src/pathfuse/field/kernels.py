@@ -16,8 +16,13 @@ buffer is grown when full, so the caller keeps the returned one).
 checks; :func:`pathfuse.simulate` calls the *same* loop with
 ``max_steps = 1`` once per tick, after writing the robot's observed position
 into ``buf[n-1]`` and the sensed discs into ``dpos, dvel, drad`` (empty
-arrays on a static map, where the disc terms vanish).  So the plan a
-controller makes and the way it drives are one code path.
+arrays when none is sensed, where the disc terms vanish).  So the plan a
+controller makes and the way it drives are one code path.  An offline run
+passes :data:`STATIC` (``None`` for the three disc arrays) instead: numba
+compiles a loop for that signature from the same source with every disc
+branch pruned (``drad is None`` is known when it compiles), so a plan on a
+static map does not compile the moving-disc code (seconds on a cold cache),
+and computes exactly what the loop does with empty disc arrays.
 
 Settings travel in small arrays (few arguments = little dispatch overhead),
 filled by :func:`pack_field` and :func:`pack_fusion`; state that persists
@@ -76,6 +81,7 @@ from pathfuse.result import (
 )
 
 __all__ = [
+    "STATIC",
     "CODE_RUNNING",
     "CODE_GOAL",
     "CODE_STALLED",
@@ -124,6 +130,10 @@ S_K, S_MODE, S_REF, S_ESC_K, S_ESCAPES, S_T, S_BACKOFF, S_WB, S_WI, S_ESTEPS = r
 N_S = 10
 
 
+#: The disc arguments ``dpos, dvel, drad`` of an offline run: no disc code is compiled.
+STATIC = (None, None, None)
+
+
 def code_status(code: int, steps: int, max_steps: int) -> Status:
     """The :class:`~pathfuse.result.Status` of a finished loop."""
     status = code_outcome(code)
@@ -151,8 +161,19 @@ def _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear):
 
 
 @njit(cache=True, inline="always")
+def _n_discs(drad):
+    """The number of sensed discs: 0 for ``None`` (a static run), which numba prunes at
+    compile time (see :data:`STATIC`)."""
+    if drad is None:
+        return 0
+    return drad.shape[0]
+
+
+@njit(cache=True, inline="always")
 def _discs(x, y, fx, fy, f, i, dpos, dvel, drad):
     """The sensed discs' repulsion for a robot heading along ``(fx, fy)``."""
+    if drad is None:  # a static run: no disc code is compiled
+        return 0.0, 0.0
     if drad.shape[0] == 0:
         return 0.0, 0.0
     fn = math.hypot(fx, fy)
@@ -337,6 +358,16 @@ def _put_discs(f, i, discs):
 
 # --------------------------------------------------------------------- fusion loop
 @njit(cache=True, inline="always")
+def _straight_escape(x, y, tx, ty, step, occ, ox, oy, res, clear):
+    """An escape move without a disc in reach: straight, at most one step, landing exactly
+    on the target (the move must be clear): ``(nx, ny, moved, reached)``."""
+    nx, ny, landed = straight_move(x, y, tx, ty, step)
+    if segment_is_clear(x, y, nx, ny, occ, ox, oy, res, clear):
+        return nx, ny, True, landed
+    return x, y, False, False
+
+
+@njit(cache=True, inline="always")
 def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, drad):
     """One escape move towards ``(tx, ty)``: ``(nx, ny, moved, reached)``.
 
@@ -347,15 +378,14 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
     within half a step.
     """
     d = math.hypot(tx - x, ty - y)
+    if drad is None:  # a static run (pruned at compile time): the straight move
+        return _straight_escape(x, y, tx, ty, step, occ, ox, oy, res, clear)
     dfx = 0.0
     dfy = 0.0
     if drad.shape[0] > 0 and d > 0.0:
         dfx, dfy = _discs(x, y, tx - x, ty - y, f, i, dpos, dvel, drad)
     if dfx == 0.0 and dfy == 0.0:
-        nx, ny, landed = straight_move(x, y, tx, ty, step)
-        if segment_is_clear(x, y, nx, ny, occ, ox, oy, res, clear):
-            return nx, ny, True, landed
-        return x, y, False, False
+        return _straight_escape(x, y, tx, ty, step, occ, ox, oy, res, clear)
     pull = f[F_KATT] * f[F_R1] / d
     fx = pull * (tx - x) + dfx
     fy = pull * (ty - y) + dfy
@@ -496,7 +526,7 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
                 nx, ny, moved, reached = _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy,
                                                       res, clear, dpos, dvel, drad)
                 esteps += 1
-                if not moved or (drad.shape[0] > 0 and esteps > 2 * stall_n):
+                if not moved or (_n_discs(drad) > 0 and esteps > 2 * stall_n):
                     mode = 0  # blocked (or held up by discs): back to Algorithm 2
                     ref = n - 1
                     continue

@@ -36,6 +36,7 @@ from pathfuse.field.kernels import (
     F_CLEAR,
     F_RVX,
     F_RVY,
+    STATIC,
     code_status,
     disc_settings,
 )
@@ -56,6 +57,8 @@ CAP_FACTOR = 10.0
 STALL_FRAC = 2.5
 
 _NO_DISCS = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0))
+#: One sensed disc, as the kernels take it: compiles a loop's online signature (warm-ups).
+ONE_DISC = (np.array([[3.5, 0.5]]), np.array([[0.0, 0.1]]), np.array([0.2]))
 
 
 def _plain(a: Any) -> np.ndarray:
@@ -308,6 +311,11 @@ class Controller:
         """Compile (or load from numba's cache) the kernels this controller runs."""
 
     @classmethod
+    def warmup_online(cls) -> None:
+        """Compile (or load) what it runs among moving discs beyond :meth:`warmup` (which
+        compiles what a plan on a static map runs)."""
+
+    @classmethod
     def diff_drive_kernels(cls) -> Sequence[Any]:
         """The further kernels it runs online on a diff-drive robot only (compiled only
         for such an episode: a command compiles what it runs)."""
@@ -378,8 +386,8 @@ class FieldController(Controller):
             p.rho0_m if p.rho0_moving_m is None else p.rho0_moving_m,
             self.disc_reach_m, p.repulsion == "velocity", p.a_max, p.swerve)
 
-    def _call(self, max_steps: int, dpos: np.ndarray, dvel: np.ndarray,
-              drad: np.ndarray) -> tuple[int, int]:  # pragma: no cover - abstract
+    def _call(self, max_steps: int, dpos: np.ndarray | None, dvel: np.ndarray | None,
+              drad: np.ndarray | None) -> tuple[int, int]:  # pragma: no cover - abstract
         raise NotImplementedError
 
     # ------------------------------------------------------------------ offline
@@ -391,7 +399,7 @@ class FieldController(Controller):
         while True:
             left = self.max_steps - total
             chunk = left if deadline is None else min(CHUNK, left)
-            code, steps = self._call(chunk, *_NO_DISCS)
+            code, steps = self._call(chunk, *STATIC)  # no disc code compiled
             total += steps
             if code != CODE_RUNNING or total >= self.max_steps:
                 break

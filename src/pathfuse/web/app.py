@@ -478,7 +478,7 @@ def _warm_all(pool: WorkerPool) -> None:
 
     for n in planner_names():
         try:
-            warm_one(REGISTRY[n])
+            warm_one(REGISTRY[n], online=True)  # the playground plans and simulates
         except Exception:  # noqa: BLE001 - a plug-in's warm-up is its own
             pass
     try:  # the page's layers, the metrics of extras and an episode's world

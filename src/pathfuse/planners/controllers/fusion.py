@@ -278,8 +278,8 @@ class FusionController(FieldController):
         self.n = n0
         return line
 
-    def _call(self, max_steps: int, dpos: np.ndarray, dvel: np.ndarray,
-              drad: np.ndarray) -> tuple[int, int]:
+    def _call(self, max_steps: int, dpos: np.ndarray | None, dvel: np.ndarray | None,
+              drad: np.ndarray | None) -> tuple[int, int]:
         self.buf, self.kbuf, self.n, code, steps = fusion_loop(
             self.buf, self.kbuf, self.n, max_steps, self.problem.grid.occupied, self.pts,
             self.cum, self.state, self.f, self.i, dpos, dvel, drad)
@@ -315,12 +315,25 @@ class FusionController(FieldController):
 
     @classmethod
     def warmup(cls) -> None:
+        """:func:`fusion_loop` for a plan on a static map (no disc code compiled)."""
         if _WARM[0]:
             return
         g = GridMap.from_rows(["....", ".#..", "...."])
-        path = [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
-        follow_path(g, (0.5, 0.5), (3.5, 2.5), path)
+        follow_path(g, (0.5, 0.5), (3.5, 2.5), _WARM_PATH)
         _WARM[0] = True
+
+    @classmethod
+    def warmup_online(cls) -> None:
+        """:func:`fusion_loop` with disc arrays, as it runs online."""
+        if _WARM[1]:
+            return
+        from pathfuse.planners.base import ONE_DISC
+
+        g = GridMap.from_rows(["....", ".#..", "...."])
+        pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5))
+        wp = np.asarray(_WARM_PATH, dtype=np.float64)
+        FusionController(pb, FusionParams(), _Path(wp), dt=0.1, max_speed=1.0)._call(1, *ONE_DISC)
+        _WARM[1] = True
 
     @classmethod
     def warmup_diff_drive(cls) -> None:
@@ -331,7 +344,8 @@ class FusionController(FieldController):
         MPPIController.warmup()  # and among discs with MPPI's sequences
 
 
-_WARM = [False]
+_WARM = [False, False]  # offline, online
+_WARM_PATH = [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
 
 
 class _Path:

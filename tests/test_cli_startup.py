@@ -31,3 +31,24 @@ def test_barn_help_states_the_jackal_defaults():
     flat = " ".join(text.split())
     assert f"(default {JACKAL_RADIUS_M:g}: the Jackal's" in flat
     assert f"(default {JACKAL_MAX_SPEED_M_S:g}, the Jackal's)" in flat
+
+
+def test_a_static_plan_compiles_only_what_it_runs():
+    """`pathfuse plan` on a static map: the fusion loop in its signature without disc
+    arrays and without a safety margin only (its moving-disc and margin code is never
+    compiled), A* with one signature, no other planner's loop, and no scipy.ndimage (the
+    paper map's regions are labelled by a flood fill)."""
+    code = ("import sys, contextlib, io\n"
+            "from pathfuse.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    main(['plan', '--map', 'paper', '--planner', 'fusion'])\n"
+            "from pathfuse.field import kernels as k\n"
+            "from pathfuse.search.kernel import _astar_kernel\n"
+            "print([[str(t) for t in s[-4:]] for s in k.fusion_loop.signatures])\n"
+            "print(len(_astar_kernel.signatures), len(k.field_loop.signatures))\n"
+            "print('scipy.ndimage' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=600)
+    assert out.stdout.split("\n")[:3] == ["[['none', 'none', 'none', 'omitted(default=None)']]",
+                                        "1 0", "False"], \
+        out.stdout

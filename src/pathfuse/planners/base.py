@@ -34,13 +34,14 @@ from pathfuse.field.kernels import (
     CODE_RUNNING,
     CODE_STALLED,
     F_CLEAR,
+    F_MARGIN,
     F_RVX,
     F_RVY,
     STATIC,
     code_status,
-    disc_settings,
 )
 from pathfuse.field.motion import MARGIN_FRAC
+from pathfuse.field.settings import disc_settings
 from pathfuse.geometry import segment_is_clear
 from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.problem import Problem
@@ -311,9 +312,15 @@ class Controller:
         """Compile (or load from numba's cache) the kernels this controller runs."""
 
     @classmethod
+    def warmup_margin(cls) -> None:
+        """Compile (or load) what a plan on a static map with a safety margin
+        (``clearance_m`` > 0) runs beyond :meth:`warmup`."""
+
+    @classmethod
     def warmup_online(cls) -> None:
-        """Compile (or load) what it runs among moving discs beyond :meth:`warmup` (which
-        compiles what a plan on a static map runs)."""
+        """Compile (or load) the kernels it runs online (:meth:`warmup` by default; the
+        field controllers' loops have a signature of their own among moving discs)."""
+        cls.warmup()
 
     @classmethod
     def diff_drive_kernels(cls) -> Sequence[Any]:
@@ -385,6 +392,12 @@ class FieldController(Controller):
             p.k_rep if p.k_rep_moving is None else p.k_rep_moving,
             p.rho0_m if p.rho0_moving_m is None else p.rho0_moving_m,
             self.disc_reach_m, p.repulsion == "velocity", p.a_max, p.swerve)
+
+    def _margin(self, dpos: np.ndarray | None) -> tuple[float, ...]:
+        """The loops' last argument, the soft safety margin: left out of a static run
+        without one (numba then compiles no margin code), ``f[F_MARGIN]`` otherwise."""
+        m = float(self.f[F_MARGIN])
+        return () if dpos is None and m <= 0.0 else (m,)
 
     def _call(self, max_steps: int, dpos: np.ndarray | None, dvel: np.ndarray | None,
               drad: np.ndarray | None) -> tuple[int, int]:  # pragma: no cover - abstract

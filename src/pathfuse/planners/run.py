@@ -29,17 +29,19 @@ from pathfuse.result import PlanResult, Status, path_length
 
 __all__ = ["solve", "start_online", "warm", "warm_query", "Stopped", "PlanInfo"]
 
-_WARM: set[tuple[str, str | None, bool, bool]] = set()
+_WARM: set[tuple[str, str | None, bool, bool, bool]] = set()
 _WARM_SEGMENT: list[bool] = []
 
 
 def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params: Any = None,
-         diff_drive: bool = False, segments: bool = True, online: bool = False) -> None:
+         diff_drive: bool = False, segments: bool = True, online: bool = False,
+         margin: bool = False) -> None:
     """Compile (or load from numba's cache) the kernels ``spec`` runs, once per process.
 
     Only what runs is compiled: the global planner that ``params`` name (the
-    preset's by default), the controller's kernels for a plan on a static map,
-    with ``online`` those it runs among moving discs too (the field loops'
+    preset's by default), the controller's kernels for a plan on a static map
+    (with ``margin``: with a safety margin, ``clearance_m`` > 0) or, with
+    ``online``, those it runs online (among moving discs: the field loops'
     signature with disc arrays), and with ``diff_drive`` (which implies
     ``online``) those it runs online on a diff-drive robot only.  ``segments`` adds the
     exact segment check the waypoints and the robot disc's end-point check
@@ -49,7 +51,7 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
     """
     gname = spec.global_planner_of(params)
     online = online or diff_drive
-    key = (spec.name, gname, diff_drive, online)
+    key = (spec.name, gname, diff_drive, online, margin)
     if key in _WARM:
         if segments and not _WARM_SEGMENT:
             _warm_segments()
@@ -65,9 +67,12 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
 
         warm_global(gname)
     if spec.controller is not None:
-        spec.controller.warmup()
         if online:
             spec.controller.warmup_online()
+        else:
+            spec.controller.warmup()
+        if margin:
+            spec.controller.warmup_margin()
         if diff_drive:
             spec.controller.warmup_diff_drive()
     _WARM.add(key)
@@ -114,7 +119,7 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     bad = problem.failure()
     if bad is not None:
         return PlanResult(bad[0], planner=spec.name, message=bad[1])
-    warm(spec, params=params, segments=segments)
+    warm(spec, params=params, segments=segments, margin=problem.clearance_m > 0)
     budget = problem.budget
     if spec.function is not None:
         res = spec.function(problem.grid, np.array(problem.start), np.array(problem.goal),

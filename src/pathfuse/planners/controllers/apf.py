@@ -38,8 +38,9 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from pathfuse.field.kernels import field_loop, pack_field
+from pathfuse.field.kernels import field_loop
 from pathfuse.field.repulsion import apf_force
+from pathfuse.field.settings import pack_field
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController
 from pathfuse.planners.params import DiscParams, FieldParams
@@ -98,7 +99,8 @@ class SubgoalController(FieldController):
               drad: np.ndarray | None) -> tuple[int, int]:
         self.buf, self.n, code, steps = field_loop(self.buf, self.n, max_steps,
                                                    self.problem.grid.occupied, self.subgoals,
-                                                   self.state, self.f, self.i, dpos, dvel, drad)
+                                                   self.state, self.f, self.i, dpos, dvel, drad,
+                                                   *self._margin(dpos))
         return code, steps
 
     @classmethod
@@ -108,6 +110,10 @@ class SubgoalController(FieldController):
     @classmethod
     def warmup(cls) -> None:
         _warm_field(online=False)
+
+    @classmethod
+    def warmup_margin(cls) -> None:
+        _warm_field(online=False, margin=True)
 
     @classmethod
     def warmup_online(cls) -> None:
@@ -121,25 +127,26 @@ class APFController(SubgoalController):
     label = "APF"
 
 
-_WARM = [False, False]  # offline, online
+_WARM: set[tuple[bool, bool]] = set()
 
 
-def _warm_field(online: bool) -> None:
+def _warm_field(online: bool, margin: bool = False) -> None:
     """Compile (or load from numba's cache) :func:`field_loop` on a tiny map: the signature
-    of a static plan (no disc code) or, ``online``, the one with disc arrays (one signature
-    with and without sensed discs)."""
-    if _WARM[online]:
+    of a static plan (no disc code; with ``margin``, that of one with a safety margin) or,
+    ``online``, the one with disc arrays (one signature with and without sensed discs)."""
+    if (online, margin) in _WARM:
         return
     from pathfuse.planners.base import ONE_DISC
     from pathfuse.result import Budget
 
     g = GridMap.from_rows(["....", ".#..", "...."])
-    pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5), budget=Budget(max_iterations=5))
+    pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5), budget=Budget(max_iterations=5),
+                        clearance_m=0.05 if margin else 0.0)
     if online:
         APFController(pb, APFParams(), dt=0.1, max_speed=1.0)._call(1, *ONE_DISC)
     else:
         APFController(pb, APFParams()).run(None)
-    _WARM[online] = True
+    _WARM.add((online, margin))
 
 
 def force_at(grid: GridMap, xy: object, goal: object, params: APFParams | None = None

@@ -82,10 +82,10 @@ from pathfuse.field.kernels import (
     S_MODE,
     S_REF,
     fusion_loop,
-    pack_fusion,
 )
 from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
+from pathfuse.field.settings import pack_fusion
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController, sensed_discs
 from pathfuse.planners.controllers.replan import replan_around_discs
@@ -282,7 +282,7 @@ class FusionController(FieldController):
               drad: np.ndarray | None) -> tuple[int, int]:
         self.buf, self.kbuf, self.n, code, steps = fusion_loop(
             self.buf, self.kbuf, self.n, max_steps, self.problem.grid.occupied, self.pts,
-            self.cum, self.state, self.f, self.i, dpos, dvel, drad)
+            self.cum, self.state, self.f, self.i, dpos, dvel, drad, *self._margin(dpos))
         return code, steps
 
     def on_stuck(self) -> None:
@@ -323,6 +323,17 @@ class FusionController(FieldController):
         _WARM[0] = True
 
     @classmethod
+    def warmup_margin(cls) -> None:
+        """:func:`fusion_loop` for a plan on a static map with a safety margin."""
+        if _WARM[2]:
+            return
+        g = GridMap.from_rows(["....", ".#..", "...."])
+        pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5), clearance_m=0.05)
+        wp = np.asarray(_WARM_PATH, dtype=np.float64)
+        FusionController(pb, FusionParams(), _Path(wp)).run(None)
+        _WARM[2] = True
+
+    @classmethod
     def warmup_online(cls) -> None:
         """:func:`fusion_loop` with disc arrays, as it runs online."""
         if _WARM[1]:
@@ -344,7 +355,7 @@ class FusionController(FieldController):
         MPPIController.warmup()  # and among discs with MPPI's sequences
 
 
-_WARM = [False, False]  # offline, online
+_WARM = [False, False, False]  # offline, online, offline with a safety margin
 _WARM_PATH = [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
 
 

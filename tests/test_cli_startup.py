@@ -52,3 +52,28 @@ def test_a_static_plan_compiles_only_what_it_runs():
     assert out.stdout.split("\n")[:3] == ["[['none', 'none', 'none', 'omitted(default=None)']]",
                                         "1 0", "False"], \
         out.stdout
+
+
+def test_is_cached_tells_a_field_loop_s_static_and_online_signatures(tmp_path):
+    """The cold-cache notice: a field loop whose index holds only a static plan's signature
+    (``None`` for the discs) is cached for a plan, not for an episode, and the reverse."""
+    from types import SimpleNamespace
+
+    from numba import types
+
+    from pathfuse.planners.kernel_cache import is_cached
+
+    index = tmp_path / "loop.nbi"
+    arr = types.float64[:, ::1]
+    static = ((arr, types.none, types.none, types.none), "magic")
+    online = ((arr, arr, arr, types.float64), "magic")
+
+    def dispatcher(keys):
+        cf = SimpleNamespace(_index_path=str(index), _load_index=lambda: dict.fromkeys(keys))
+        return SimpleNamespace(_cache=SimpleNamespace(_cache_file=cf))
+
+    assert not is_cached(dispatcher([static]))  # no index on disk
+    index.write_bytes(b"")
+    assert [is_cached(dispatcher([static]), k) for k in (None, False, True)] == [True, True, False]
+    assert [is_cached(dispatcher([online]), k) for k in (None, False, True)] == [True, False, True]
+    assert is_cached(dispatcher([static, online]), True) and is_cached(dispatcher([]), None)

@@ -58,7 +58,8 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
         return
     from pathfuse.planners.kernel_cache import cold_kernels
 
-    if notify is not None and cold_kernels(spec, params=params, diff_drive=diff_drive):
+    if notify is not None and cold_kernels(spec, params=params, diff_drive=diff_drive,
+                                           online=online):
         notify()
     if segments and not _WARM_SEGMENT:
         _warm_segments()

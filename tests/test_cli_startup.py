@@ -31,3 +31,49 @@ def test_barn_help_states_the_jackal_defaults():
     flat = " ".join(text.split())
     assert f"(default {JACKAL_RADIUS_M:g}: the Jackal's" in flat
     assert f"(default {JACKAL_MAX_SPEED_M_S:g}, the Jackal's)" in flat
+
+
+def test_a_static_plan_compiles_only_what_it_runs():
+    """`pathfuse plan` on a static map: the fusion loop in its signature without disc
+    arrays and without a safety margin only (its moving-disc and margin code is never
+    compiled), A* with one signature, no other planner's loop, and no scipy.ndimage (the
+    paper map's regions are labelled by a flood fill)."""
+    code = ("import sys, contextlib, io\n"
+            "from pathfuse.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    main(['plan', '--map', 'paper', '--planner', 'fusion'])\n"
+            "from pathfuse.field import kernels as k\n"
+            "from pathfuse.search.kernel import _astar_kernel\n"
+            "print([[str(t) for t in s[-4:]] for s in k.fusion_loop.signatures])\n"
+            "print(len(_astar_kernel.signatures), len(k.field_loop.signatures))\n"
+            "print('scipy.ndimage' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=600)
+    assert out.stdout.split("\n")[:3] == ["[['none', 'none', 'none', 'omitted(default=None)']]",
+                                        "1 0", "False"], \
+        out.stdout
+
+
+def test_is_cached_tells_a_field_loop_s_static_and_online_signatures(tmp_path):
+    """The cold-cache notice: a field loop whose index holds only a static plan's signature
+    (``None`` for the discs) is cached for a plan, not for an episode, and the reverse."""
+    from types import SimpleNamespace
+
+    from numba import types
+
+    from pathfuse.planners.kernel_cache import is_cached
+
+    index = tmp_path / "loop.nbi"
+    arr = types.float64[:, ::1]
+    static = ((arr, types.none, types.none, types.none), "magic")
+    online = ((arr, arr, arr, types.float64), "magic")
+
+    def dispatcher(keys):
+        cf = SimpleNamespace(_index_path=str(index), _load_index=lambda: dict.fromkeys(keys))
+        return SimpleNamespace(_cache=SimpleNamespace(_cache_file=cf))
+
+    assert not is_cached(dispatcher([static]))  # no index on disk
+    index.write_bytes(b"")
+    assert [is_cached(dispatcher([static]), k) for k in (None, False, True)] == [True, True, False]
+    assert [is_cached(dispatcher([online]), k) for k in (None, False, True)] == [True, False, True]
+    assert is_cached(dispatcher([static, online]), True) and is_cached(dispatcher([]), None)

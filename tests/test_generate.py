@@ -195,3 +195,26 @@ def test_impossible_connection_raises():
     with pytest.raises(MapError, match="after 40 attempts"):
         random_map((5.0, 1.0), obstacles=2, connect=[((0.5, 0.5), (4.5, 0.5))],
                    max_attempts=40)
+
+
+
+@pytest.mark.parametrize("small", [1 << 12, 0])  # the flood fill in Python; scipy's labels
+def test_label_regions_equal_scipy_labels(monkeypatch, small):
+    """The region labels of the generator and of A* equal scipy.ndimage.label's, 4- and
+    8-connected, numbering included."""
+    from scipy import ndimage
+
+    import pathfuse.grid as grid_mod
+
+    monkeypatch.setattr(grid_mod, "SMALL_LABELS", small)
+    rng = np.random.default_rng(5)
+    regions = []
+    for _ in range(800):
+        h, w = (int(v) for v in rng.integers(1, 20, 2))
+        free = rng.random((h, w)) < rng.uniform(0.2, 0.9)
+        for eight in (False, True):
+            expect, n = ndimage.label(free, structure=np.ones((3, 3), bool) if eight else None)
+            got = grid_mod.label_regions(free, eight=eight)
+            assert got.dtype == np.int32 and np.array_equal(got, expect), (free, eight)
+            regions.append(n)
+    assert max(regions) > 10 and min(regions) == 0

@@ -113,7 +113,7 @@ def segment_box_distance(ax, ay, bx, by, x0, y0, x1, y1):
     return d
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _cell_blocks(ax, ay, bx, by, x0, y0, res, clear):
     """Whether the square ``[x0, x0+res] x [y0, y0+res]`` is closer than ``clear`` to ``AB``."""
     # cheap exact rejection: missing the box grown by ``clear`` as a square means the

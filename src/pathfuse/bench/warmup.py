@@ -38,7 +38,8 @@ def cold_kernels_of(planners: Iterable[str], metrics: bool = True,
     from pathfuse.planners.kernel_cache import cold_kernels, is_cached
     from pathfuse.planners.registry import get_planner
 
-    out = [n for n in dict.fromkeys(planners) if cold_kernels(get_planner(n), diff_drive=world)]
+    out = [n for n in dict.fromkeys(planners)
+           if cold_kernels(get_planner(n), diff_drive=world, online=world)]
     if metrics and not all(is_cached(k) for k in _metric_kernels()):
         out.append("the metrics")
     if world and not all(is_cached(k) for k in _world_kernels()):
@@ -65,7 +66,7 @@ def warm_kernels(planners: Iterable[str], metrics: bool = True, world: bool = Fa
     if cold and notify is not None:
         notify(f"compiling the kernels of {_and(cold)} (first run only; cached afterwards)")
     for n in names:  # a world's robot may be a diff-drive one
-        warm(get_planner(n), diff_drive=world)
+        warm(get_planner(n), diff_drive=world, online=world)
     if metrics:
         from pathfuse.metrics_kernels import warmup
 

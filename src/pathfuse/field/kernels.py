@@ -16,11 +16,17 @@ buffer is grown when full, so the caller keeps the returned one).
 checks; :func:`pathfuse.simulate` calls the *same* loop with
 ``max_steps = 1`` once per tick, after writing the robot's observed position
 into ``buf[n-1]`` and the sensed discs into ``dpos, dvel, drad`` (empty
-arrays on a static map, where the disc terms vanish).  So the plan a
-controller makes and the way it drives are one code path.
+arrays when none is sensed, where the disc terms vanish).  So the plan a
+controller makes and the way it drives are one code path.  An offline run
+passes :data:`STATIC` (``None`` for the discs): numba prunes every ``drad is
+None`` branch when it compiles that signature, so a static plan compiles no
+disc code (seconds on a cold cache) and computes what empty arrays give.  The
+last argument, ``margin``, is the soft safety margin (``f[F_MARGIN]``); a
+static run without one omits it (``None``), which prunes the margin's code
+the same way.
 
 Settings travel in small arrays (few arguments = little dispatch overhead),
-filled by :func:`pack_field` and :func:`pack_fusion`; state that persists
+filled by :mod:`pathfuse.field.settings`; state that persists
 between calls lives in an ``int64`` array (``state``).
 
 Codes: :data:`CODE_RUNNING` (``max_steps`` reached: call again),
@@ -76,6 +82,7 @@ from pathfuse.result import (
 )
 
 __all__ = [
+    "STATIC",
     "CODE_RUNNING",
     "CODE_GOAL",
     "CODE_STALLED",
@@ -85,8 +92,6 @@ __all__ = [
     "code_status",
     "field_loop",
     "fusion_loop",
-    "pack_field",
-    "pack_fusion",
 ]
 
 # The loops' codes, from :class:`~pathfuse.result.Status` (:data:`~pathfuse.result.CODE_SUCCESS`).
@@ -124,6 +129,10 @@ S_K, S_MODE, S_REF, S_ESC_K, S_ESCAPES, S_T, S_BACKOFF, S_WB, S_WI, S_ESTEPS = r
 N_S = 10
 
 
+#: The disc arguments ``dpos, dvel, drad`` of an offline run: no disc code is compiled.
+STATIC = (None, None, None)
+
+
 def code_status(code: int, steps: int, max_steps: int) -> Status:
     """The :class:`~pathfuse.result.Status` of a finished loop."""
     status = code_outcome(code)
@@ -153,6 +162,8 @@ def _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear):
 @njit(cache=True, inline="always")
 def _discs(x, y, fx, fy, f, i, dpos, dvel, drad):
     """The sensed discs' repulsion for a robot heading along ``(fx, fy)``."""
+    if drad is None:  # a static run: no disc code is compiled
+        return 0.0, 0.0
     if drad.shape[0] == 0:
         return 0.0, 0.0
     fn = math.hypot(fx, fy)
@@ -174,6 +185,8 @@ def _step(x, y, fx, fy, step, occ, ox, oy, res, clear, safe, radius, margin):
     that touches an obstacle (closer than ``radius``; for a point any contact).
     """
     if safe:
+        if margin is None:  # no margin (pruned when compiled): the safe step itself
+            return safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
         return safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, margin)
     fn = math.hypot(fx, fy)
     if not (fn > 0.0) or not math.isfinite(fn):
@@ -209,7 +222,7 @@ def _grow_int(kbuf, n):
 
 # --------------------------------------------------------------------- field loop
 @njit(cache=True)
-def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
+def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad, margin=None):
     """APF steps through the sub-goals ``subs`` (K, 2), the last one the goal.
 
     The current sub-goal ``subs[state[S_SUB]]`` attracts (eq. 5); it is
@@ -276,7 +289,7 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
         fy += ry
         dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
         nx, ny, how = _step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear, safe,
-                            radius, f[F_MARGIN])
+                            radius, margin)
         if how == HOW_BLOCKED:
             code = CODE_BLOCKED
             break
@@ -298,43 +311,6 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad):
     return buf, n, code, steps
 
 
-def pack_field(goal, k_att, k_rep, rho0_m, step_m, tol_m, clear_m, stall_steps,
-               stall_distance_m, ox, oy, res, subgoal_tol_m, improved, to_goal, rep_exponent,
-               rep_scale_m, discs, safe_step=True, stall_exit=True, margin_m=0.0,
-               boundary=False, offset_m=0.5):
-    """Float and int settings of :func:`field_loop`; ``discs`` is :func:`disc_settings`."""
-    f = np.zeros(N_F)
-    f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
-    f[F_KATT], f[F_KREP], f[F_RHO0] = k_att, k_rep, rho0_m
-    f[F_STEP], f[F_TOL], f[F_CLEAR], f[F_STALLD] = step_m, tol_m, clear_m, stall_distance_m
-    f[F_OX], f[F_OY], f[F_RES] = ox, oy, res
-    f[F_SUBTOL], f[F_NEXP], f[F_SCALE] = subgoal_tol_m, rep_exponent, rep_scale_m
-    f[F_MARGIN] = margin_m
-    f[F_OFFSET] = offset_m
-    i = np.zeros(N_I, dtype=np.int64)
-    i[I_STALLN] = stall_steps
-    i[I_IMPROVED] = 1 if improved else 0
-    i[I_TOGOAL] = 1 if to_goal else 0
-    i[I_SAFE] = 1 if safe_step else 0
-    i[I_STALL] = 1 if stall_exit else 0
-    i[I_BOUNDARY] = 1 if boundary else 0
-    _put_discs(f, i, discs)
-    return f, i
-
-
-def disc_settings(robot_radius_m, k_rep_moving, rho0_moving_m, reach_m, velocity_aware, a_max,
-                  swerve):
-    """The moving-disc settings of both loops, as a tuple for :func:`pack_field`."""
-    return (robot_radius_m, k_rep_moving, rho0_moving_m, reach_m, velocity_aware, a_max, swerve)
-
-
-def _put_discs(f, i, discs):
-    r, k, rho, reach, va, a_max, swerve = discs
-    f[F_RADIUS], f[F_KMOV], f[F_RHOMOV], f[F_REACH] = r, k, rho, reach
-    f[F_AMAX], f[F_SWERVE] = a_max, swerve
-    i[I_VELAWARE] = 1 if va else 0
-
-
 # --------------------------------------------------------------------- fusion loop
 @njit(cache=True, inline="always")
 def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, drad):
@@ -349,9 +325,9 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
     d = math.hypot(tx - x, ty - y)
     dfx = 0.0
     dfy = 0.0
-    if drad.shape[0] > 0 and d > 0.0:
+    if drad is not None and drad.shape[0] > 0 and d > 0.0:
         dfx, dfy = _discs(x, y, tx - x, ty - y, f, i, dpos, dvel, drad)
-    if dfx == 0.0 and dfy == 0.0:
+    if drad is None or (dfx == 0.0 and dfy == 0.0):  # a static run compiles this move only
         nx, ny, landed = straight_move(x, y, tx, ty, step)
         if segment_is_clear(x, y, nx, ny, occ, ox, oy, res, clear):
             return nx, ny, True, landed
@@ -373,7 +349,8 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
 # so split into calls every piece would pass that state in and out.  The force and the
 # step already are helpers (fusion_force, _step, _escape_move, _goal_reached).
 @njit(cache=True)
-def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel, drad):
+def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel, drad,
+                margin=None):
     """Algorithm 2 steps from ``buf[n-1]`` along the global path ``pts`` (M, 2).
 
     ``pts`` ends at the goal, ``cum`` (M,) is its cumulative arc length,
@@ -462,7 +439,7 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
                                      r1, r2, occ, ox, oy, res, boundary, offset)
             dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
             nx, ny, how = _step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear, safe,
-                                radius, f[F_MARGIN])
+                                radius, margin)
             if how == HOW_BLOCKED:
                 blocked = True
             else:
@@ -496,7 +473,7 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
                 nx, ny, moved, reached = _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy,
                                                       res, clear, dpos, dvel, drad)
                 esteps += 1
-                if not moved or (drad.shape[0] > 0 and esteps > 2 * stall_n):
+                if not moved or (drad is not None and drad.shape[0] > 0 and esteps > 2 * stall_n):
                     mode = 0  # blocked (or held up by discs): back to Algorithm 2
                     ref = n - 1
                     continue
@@ -527,9 +504,9 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
             ri = -1
             rj = -1
             if escape == 1:
-                if f[F_MARGIN] > 0.0:  # a way back that keeps the safety margin first
+                if margin is not None and margin > 0.0:  # a way back keeping the margin first
                     ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox,
-                                         oy, res, clear + f[F_MARGIN], kbuf, drive)
+                                         oy, res, clear + margin, kbuf, drive)
                 if ri < 0:
                     ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox,
                                          oy, res, clear, kbuf, drive)
@@ -562,29 +539,3 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
     state[S_WI] = wi
     state[S_ESTEPS] = esteps
     return buf, kbuf, n, code, steps
-
-
-def pack_fusion(goal, k_att, k_rep, rho0_m, r1_m, r2_m, step_m, tol_m, clear_m, stall_steps,
-                stall_distance_m, ox, oy, res, ahead, escape, escape_points, backoff_window_m,
-                drive, discs, safe_step=True, stall_exit=True, margin_m=0.0, boundary=False,
-                offset_m=0.5):
-    """Float and int settings of :func:`fusion_loop` (``r2_m`` is the repulsion radius)."""
-    f = np.zeros(N_F)
-    f[F_GX], f[F_GY] = float(goal[0]), float(goal[1])
-    f[F_KATT], f[F_KREP], f[F_RHO0] = k_att, k_rep, rho0_m
-    f[F_STEP], f[F_TOL], f[F_CLEAR], f[F_STALLD] = step_m, tol_m, clear_m, stall_distance_m
-    f[F_OX], f[F_OY], f[F_RES] = ox, oy, res
-    f[F_R1], f[F_R2], f[F_BACKOFF] = r1_m, r2_m, backoff_window_m
-    f[F_MARGIN] = margin_m
-    f[F_OFFSET] = offset_m
-    i = np.zeros(N_I, dtype=np.int64)
-    i[I_STALLN] = stall_steps
-    i[I_AHEAD] = ahead
-    i[I_ESCAPE] = 1 if escape else 0
-    i[I_ESC_PTS] = escape_points
-    i[I_DRIVE] = 1 if drive else 0
-    i[I_SAFE] = 1 if safe_step else 0
-    i[I_STALL] = 1 if stall_exit else 0
-    i[I_BOUNDARY] = 1 if boundary else 0
-    _put_discs(f, i, discs)
-    return f, i

@@ -511,7 +511,7 @@ class IrsimController:
         model = sc.robot
         self.problem = Problem.create(sc.grid, sc.start, sc.goal, model.radius_m,
                                       clearance_m=model.clearance_m, robot=model)
-        warm(spec)
+        warm(spec, online=True)
         from pathfuse.shield import warmup_shield
 
         warmup_shield()

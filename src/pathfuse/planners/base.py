@@ -34,12 +34,14 @@ from pathfuse.field.kernels import (
     CODE_RUNNING,
     CODE_STALLED,
     F_CLEAR,
+    F_MARGIN,
     F_RVX,
     F_RVY,
+    STATIC,
     code_status,
-    disc_settings,
 )
 from pathfuse.field.motion import MARGIN_FRAC
+from pathfuse.field.settings import disc_settings
 from pathfuse.geometry import segment_is_clear
 from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.problem import Problem
@@ -56,6 +58,8 @@ CAP_FACTOR = 10.0
 STALL_FRAC = 2.5
 
 _NO_DISCS = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0))
+#: One sensed disc, as the kernels take it: compiles a loop's online signature (warm-ups).
+ONE_DISC = (np.array([[3.5, 0.5]]), np.array([[0.0, 0.1]]), np.array([0.2]))
 
 
 def _plain(a: Any) -> np.ndarray:
@@ -308,6 +312,17 @@ class Controller:
         """Compile (or load from numba's cache) the kernels this controller runs."""
 
     @classmethod
+    def warmup_margin(cls) -> None:
+        """Compile (or load) what a plan on a static map with a safety margin
+        (``clearance_m`` > 0) runs beyond :meth:`warmup`."""
+
+    @classmethod
+    def warmup_online(cls) -> None:
+        """Compile (or load) the kernels it runs online (:meth:`warmup` by default; the
+        field controllers' loops have a signature of their own among moving discs)."""
+        cls.warmup()
+
+    @classmethod
     def diff_drive_kernels(cls) -> Sequence[Any]:
         """The further kernels it runs online on a diff-drive robot only (compiled only
         for such an episode: a command compiles what it runs)."""
@@ -378,8 +393,14 @@ class FieldController(Controller):
             p.rho0_m if p.rho0_moving_m is None else p.rho0_moving_m,
             self.disc_reach_m, p.repulsion == "velocity", p.a_max, p.swerve)
 
-    def _call(self, max_steps: int, dpos: np.ndarray, dvel: np.ndarray,
-              drad: np.ndarray) -> tuple[int, int]:  # pragma: no cover - abstract
+    def _margin(self, dpos: np.ndarray | None) -> tuple[float, ...]:
+        """The loops' last argument, the soft safety margin: left out of a static run
+        without one (numba then compiles no margin code), ``f[F_MARGIN]`` otherwise."""
+        m = float(self.f[F_MARGIN])
+        return () if dpos is None and m <= 0.0 else (m,)
+
+    def _call(self, max_steps: int, dpos: np.ndarray | None, dvel: np.ndarray | None,
+              drad: np.ndarray | None) -> tuple[int, int]:  # pragma: no cover - abstract
         raise NotImplementedError
 
     # ------------------------------------------------------------------ offline
@@ -391,7 +412,7 @@ class FieldController(Controller):
         while True:
             left = self.max_steps - total
             chunk = left if deadline is None else min(CHUNK, left)
-            code, steps = self._call(chunk, *_NO_DISCS)
+            code, steps = self._call(chunk, *STATIC)  # no disc code compiled
             total += steps
             if code != CODE_RUNNING or total >= self.max_steps:
                 break

@@ -13,19 +13,39 @@ from typing import Any
 __all__ = ["cold_kernels", "is_cached"]
 
 
-def is_cached(dispatcher: Any) -> bool:
-    """True when ``dispatcher`` (an ``@njit(cache=True)`` function) has an index on disk."""
+def is_cached(dispatcher: Any, online: bool | None = None) -> bool:
+    """True when ``dispatcher`` (an ``@njit(cache=True)`` function) has an index on disk.
+
+    The field loops (:mod:`pathfuse.field.kernels`) have two kinds of signature, a
+    static plan's (``None`` for the discs) and an online one's: with ``online`` given,
+    the index must hold one of that kind.
+    """
     try:
-        index = dispatcher._cache._cache_file._index_path
+        cache_file = dispatcher._cache._cache_file
+        index = cache_file._index_path
     except AttributeError:
         return True
-    return os.path.exists(index)
+    if not os.path.exists(index):
+        return False
+    if online is None:
+        return True
+    try:
+        from numba import types
+
+        keys = list(cache_file._load_index())
+        return any(online != any(isinstance(t, types.NoneType) for t in key[0])
+                   for key in keys)
+    except Exception:  # noqa: BLE001 - numba's internals differ: count it as cached
+        return True
 
 
-def cold_kernels(spec: Any, params: Any = None, diff_drive: bool = False) -> list[str]:
+def cold_kernels(spec: Any, params: Any = None, diff_drive: bool = False,
+                 online: bool = False) -> list[str]:
     """Names of the kernels ``spec`` (a PlannerSpec) runs with ``params`` (its global
-    planner's and its controller's, with ``diff_drive`` those of a diff-drive robot too)
-    that numba must still compile."""
+    planner's and its controller's, online with ``online``, with ``diff_drive`` those of
+    a diff-drive robot too) that numba must still compile."""
+    from pathfuse.field.kernels import field_loop, fusion_loop
+
     kernels: list[Any] = []
     gname = spec.global_planner_of(params)
     if gname is not None:
@@ -36,4 +56,6 @@ def cold_kernels(spec: Any, params: Any = None, diff_drive: bool = False) -> lis
         kernels.extend(spec.controller.kernels())
         if diff_drive:
             kernels.extend(spec.controller.diff_drive_kernels())
-    return [getattr(k, "__name__", str(k)) for k in kernels if not is_cached(k)]
+    online = online or diff_drive
+    return [getattr(k, "__name__", str(k)) for k in kernels
+            if not is_cached(k, online if k is field_loop or k is fusion_loop else None)]

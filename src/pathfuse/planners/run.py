@@ -29,31 +29,37 @@ from pathfuse.result import PlanResult, Status, path_length
 
 __all__ = ["solve", "start_online", "warm", "warm_query", "Stopped", "PlanInfo"]
 
-_WARM: set[tuple[str, str | None, bool]] = set()
+_WARM: set[tuple[str, str | None, bool, bool, bool]] = set()
 _WARM_SEGMENT: list[bool] = []
 
 
 def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params: Any = None,
-         diff_drive: bool = False, segments: bool = True) -> None:
+         diff_drive: bool = False, segments: bool = True, online: bool = False,
+         margin: bool = False) -> None:
     """Compile (or load from numba's cache) the kernels ``spec`` runs, once per process.
 
     Only what runs is compiled: the global planner that ``params`` name (the
-    preset's by default), the controller's kernels, and with ``diff_drive``
-    those it runs online on a diff-drive robot only.  ``segments`` adds the
+    preset's by default), the controller's kernels for a plan on a static map
+    (with ``margin``: with a safety margin, ``clearance_m`` > 0) or, with
+    ``online``, those it runs online (among moving discs: the field loops'
+    signature with disc arrays), and with ``diff_drive`` (which implies
+    ``online``) those it runs online on a diff-drive robot only.  ``segments`` adds the
     exact segment check the waypoints and the robot disc's end-point check
     use (a point robot's ``astar`` plan needs neither).  ``notify`` is called
     first when the kernels are not in numba's on-disk cache yet (the command
     line prints a one-line notice with it).
     """
     gname = spec.global_planner_of(params)
-    key = (spec.name, gname, diff_drive)
+    online = online or diff_drive
+    key = (spec.name, gname, diff_drive, online, margin)
     if key in _WARM:
         if segments and not _WARM_SEGMENT:
             _warm_segments()
         return
     from pathfuse.planners.kernel_cache import cold_kernels
 
-    if notify is not None and cold_kernels(spec, params=params, diff_drive=diff_drive):
+    if notify is not None and cold_kernels(spec, params=params, diff_drive=diff_drive,
+                                           online=online):
         notify()
     if segments and not _WARM_SEGMENT:
         _warm_segments()
@@ -62,7 +68,12 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
 
         warm_global(gname)
     if spec.controller is not None:
-        spec.controller.warmup()
+        if online:
+            spec.controller.warmup_online()
+        else:
+            spec.controller.warmup()
+        if margin:
+            spec.controller.warmup_margin()
         if diff_drive:
             spec.controller.warmup_diff_drive()
     _WARM.add(key)
@@ -109,7 +120,7 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     bad = problem.failure()
     if bad is not None:
         return PlanResult(bad[0], planner=spec.name, message=bad[1])
-    warm(spec, params=params, segments=segments)
+    warm(spec, params=params, segments=segments, margin=problem.clearance_m > 0)
     budget = problem.budget
     if spec.function is not None:
         res = spec.function(problem.grid, np.array(problem.start), np.array(problem.goal),
@@ -171,7 +182,7 @@ def start_online(spec: PlannerSpec, problem: Problem, params: Any, dt: float,
         raise ConfigError(f"planner {spec.name!r} only plans offline (a plug-in function); "
                           "it cannot be simulated")
     rb = problem.robot
-    warm(spec, params=params, diff_drive=rb is not None and rb.is_diff_drive)
+    warm(spec, params=params, diff_drive=rb is not None and rb.is_diff_drive, online=True)
     gp = None
     gname = spec.global_planner_of(params)
     if gname is not None:

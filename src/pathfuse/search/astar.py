@@ -78,6 +78,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pathfuse.grid import label_regions
 from pathfuse.result import (
     CODE_GROW,
     CODE_NO_PATH,
@@ -167,11 +168,7 @@ class _Regions:
         grid = self._grid() if self._grid is not None else None
         if grid is not None and not self.corner_cutting:
             return np.asarray(grid.components)
-        from scipy import ndimage
-
-        structure = np.ones((3, 3), dtype=bool) if self.corner_cutting else None
-        labels, _ = ndimage.label(~self._occ, structure=structure)
-        return np.asarray(labels)
+        return label_regions(~self._occ, eight=self.corner_cutting)
 
 
 class AStarSearcher(_Regions):

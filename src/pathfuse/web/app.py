@@ -478,7 +478,8 @@ def _warm_all(pool: WorkerPool) -> None:
 
     for n in planner_names():
         try:
-            warm_one(REGISTRY[n])
+            for online in (False, True):  # the playground plans and simulates
+                warm_one(REGISTRY[n], online=online)
         except Exception:  # noqa: BLE001 - a plug-in's warm-up is its own
             pass
     try:  # the page's layers, the metrics of extras and an episode's world

@@ -260,7 +260,7 @@ def _params_of(spec: Any, params: Any) -> Any:
 
 def _warm(spec: Any, model: RobotModel, cfg: Any) -> None:
     """Compile (or load) the kernels an episode runs, so that none compiles on a tick."""
-    warm(spec, params=cfg, diff_drive=model.is_diff_drive)
+    warm(spec, params=cfg, diff_drive=model.is_diff_drive, online=True)
     from pathfuse.shield import warmup_shield
 
     warmup_shield()  # the world's clip and the shield

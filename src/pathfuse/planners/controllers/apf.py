@@ -38,8 +38,9 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from pathfuse.field.kernels import field_loop, pack_field
+from pathfuse.field.kernels import field_loop
 from pathfuse.field.repulsion import apf_force
+from pathfuse.field.settings import pack_field
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController
 from pathfuse.planners.params import DiscParams, FieldParams
@@ -94,11 +95,12 @@ class SubgoalController(FieldController):
     def rep_scale(self) -> float:
         return 1.0
 
-    def _call(self, max_steps: int, dpos: np.ndarray, dvel: np.ndarray,
-              drad: np.ndarray) -> tuple[int, int]:
+    def _call(self, max_steps: int, dpos: np.ndarray | None, dvel: np.ndarray | None,
+              drad: np.ndarray | None) -> tuple[int, int]:
         self.buf, self.n, code, steps = field_loop(self.buf, self.n, max_steps,
                                                    self.problem.grid.occupied, self.subgoals,
-                                                   self.state, self.f, self.i, dpos, dvel, drad)
+                                                   self.state, self.f, self.i, dpos, dvel, drad,
+                                                   *self._margin(dpos))
         return code, steps
 
     @classmethod
@@ -107,7 +109,15 @@ class SubgoalController(FieldController):
 
     @classmethod
     def warmup(cls) -> None:
-        _warm_field()
+        _warm_field(online=False)
+
+    @classmethod
+    def warmup_margin(cls) -> None:
+        _warm_field(online=False, margin=True)
+
+    @classmethod
+    def warmup_online(cls) -> None:
+        _warm_field(online=True)
 
 
 class APFController(SubgoalController):
@@ -117,20 +127,26 @@ class APFController(SubgoalController):
     label = "APF"
 
 
-_WARM = [False]
+_WARM: set[tuple[bool, bool]] = set()
 
 
-def _warm_field() -> None:
-    """Compile (or load from numba's cache) :func:`field_loop` on a tiny map, with and
-    without discs (one signature serves both)."""
-    if _WARM[0]:
+def _warm_field(online: bool, margin: bool = False) -> None:
+    """Compile (or load from numba's cache) :func:`field_loop` on a tiny map: the signature
+    of a static plan (no disc code; with ``margin``, that of one with a safety margin) or,
+    ``online``, the one with disc arrays (one signature with and without sensed discs)."""
+    if (online, margin) in _WARM:
         return
+    from pathfuse.planners.base import ONE_DISC
     from pathfuse.result import Budget
 
     g = GridMap.from_rows(["....", ".#..", "...."])
-    pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5), budget=Budget(max_iterations=5))
-    APFController(pb, APFParams()).run(None)
-    _WARM[0] = True
+    pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5), budget=Budget(max_iterations=5),
+                        clearance_m=0.05 if margin else 0.0)
+    if online:
+        APFController(pb, APFParams(), dt=0.1, max_speed=1.0)._call(1, *ONE_DISC)
+    else:
+        APFController(pb, APFParams()).run(None)
+    _WARM.add((online, margin))
 
 
 def force_at(grid: GridMap, xy: object, goal: object, params: APFParams | None = None

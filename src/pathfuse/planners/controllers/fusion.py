@@ -82,10 +82,10 @@ from pathfuse.field.kernels import (
     S_MODE,
     S_REF,
     fusion_loop,
-    pack_fusion,
 )
 from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
+from pathfuse.field.settings import pack_fusion
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController, sensed_discs
 from pathfuse.planners.controllers.replan import replan_around_discs
@@ -284,11 +284,11 @@ class FusionController(FieldController):
         self.n = n0
         return line
 
-    def _call(self, max_steps: int, dpos: np.ndarray, dvel: np.ndarray,
-              drad: np.ndarray) -> tuple[int, int]:
+    def _call(self, max_steps: int, dpos: np.ndarray | None, dvel: np.ndarray | None,
+              drad: np.ndarray | None) -> tuple[int, int]:
         self.buf, self.kbuf, self.n, code, steps = fusion_loop(
             self.buf, self.kbuf, self.n, max_steps, self.problem.grid.occupied, self.pts,
-            self.cum, self.state, self.f, self.i, dpos, dvel, drad)
+            self.cum, self.state, self.f, self.i, dpos, dvel, drad, *self._margin(dpos))
         return code, steps
 
     def on_stuck(self) -> None:
@@ -321,12 +321,36 @@ class FusionController(FieldController):
 
     @classmethod
     def warmup(cls) -> None:
+        """:func:`fusion_loop` for a plan on a static map (no disc code compiled)."""
         if _WARM[0]:
             return
         g = GridMap.from_rows(["....", ".#..", "...."])
-        path = [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
-        follow_path(g, (0.5, 0.5), (3.5, 2.5), path)
+        follow_path(g, (0.5, 0.5), (3.5, 2.5), _WARM_PATH)
         _WARM[0] = True
+
+    @classmethod
+    def warmup_margin(cls) -> None:
+        """:func:`fusion_loop` for a plan on a static map with a safety margin."""
+        if _WARM[2]:
+            return
+        g = GridMap.from_rows(["....", ".#..", "...."])
+        pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5), clearance_m=0.05)
+        wp = np.asarray(_WARM_PATH, dtype=np.float64)
+        FusionController(pb, FusionParams(), _Path(wp)).run(None)
+        _WARM[2] = True
+
+    @classmethod
+    def warmup_online(cls) -> None:
+        """:func:`fusion_loop` with disc arrays, as it runs online."""
+        if _WARM[1]:
+            return
+        from pathfuse.planners.base import ONE_DISC
+
+        g = GridMap.from_rows(["....", ".#..", "...."])
+        pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5))
+        wp = np.asarray(_WARM_PATH, dtype=np.float64)
+        FusionController(pb, FusionParams(), _Path(wp), dt=0.1, max_speed=1.0)._call(1, *ONE_DISC)
+        _WARM[1] = True
 
     @classmethod
     def warmup_diff_drive(cls) -> None:
@@ -337,7 +361,8 @@ class FusionController(FieldController):
         MPPIController.warmup()  # and among discs with MPPI's sequences
 
 
-_WARM = [False]
+_WARM = [False, False, False]  # offline, online, offline with a safety margin
+_WARM_PATH = [[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 1.5], [3.5, 2.5]]
 
 
 class _Path:

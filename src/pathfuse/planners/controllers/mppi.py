@@ -80,13 +80,13 @@ from __future__ import annotations
 
 import math
 import time
-import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
+from pathfuse.costmap import clearance_lattice
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.grid import GridMap
@@ -198,40 +198,12 @@ class MPPIParams(PersonalSpaceParams, GlobalAStarParams):
                                          "ticks is a stall")
 
 
-_FIELDS: weakref.WeakKeyDictionary[GridMap, dict[float, tuple[np.ndarray, float]]] = \
-    weakref.WeakKeyDictionary()
-_MAX_FIELD_CELLS = 4_000_000
-
-
 def clearance_field(grid: GridMap, cell_m: float) -> tuple[np.ndarray, float]:
     """A clearance lower bound on a lattice of the map's cells split ``s x s`` (``s`` up to 8,
-    so that a lattice cell is about ``cell_m``): the distance from each lattice cell centre to
-    the nearest occupied square, less half a lattice cell's diagonal (that is
-    :attr:`GridMap.distance_field` less a cell's half-diagonal when ``s = 1``).  Returns
+    so that a lattice cell is about ``cell_m``): :func:`pathfuse.costmap.clearance_lattice`,
+    the distance layer of the :class:`~pathfuse.costmap.Costmap`.  Returns
     ``(field, lattice cell side)``; cached per map."""
-    res = float(grid.resolution)
-    h, w = grid.shape
-    s = max(1, min(8, int(math.ceil(res / cell_m - 1e-9))))
-    while s > 1 and h * w * s * s > _MAX_FIELD_CELLS:
-        s -= 1
-    per = _FIELDS.setdefault(grid, {})
-    hit = per.get(float(s))
-    if hit is not None:
-        return hit
-    r = res / s
-    if s == 1:
-        df = grid.distance_field
-    elif not grid.occupied.any():
-        df = np.full((h * s, w * s), np.inf)
-    else:
-        from scipy import ndimage
-
-        fine = np.repeat(np.repeat(grid.occupied, s, axis=0), s, axis=1)
-        df = ndimage.distance_transform_edt(~fine) * r
-    out = np.ascontiguousarray(df - r * math.sqrt(0.5), dtype=np.float64)
-    out.setflags(write=False)
-    per[float(s)] = (out, r)
-    return out, r
+    return clearance_lattice(grid, cell_m)
 
 
 def _offline_robot(problem: Problem) -> RobotModel:

@@ -138,7 +138,7 @@ def test_point_distance_and_clear_agree_with_brute_force():
         xs = np.append(xs, [cm.ox_m - 0.01, cm.xmax_m + 0.3])
         ys = np.append(ys, [cm.oy_m + 0.5 * (cm.ymax_m - cm.oy_m)] * 2)
         want = _brute(cm, xs, ys)
-        for x, y, d in zip(xs, ys, want):
+        for x, y, d in zip(xs, ys, want, strict=True):
             got = point_distance(cm, float(x), float(y), 1e9)
             assert got == pytest.approx(d, abs=1e-12)
             cap = 0.5 * cm.res_m
@@ -154,7 +154,7 @@ def test_segment_distance_and_clear_agree_with_brute_force():
         cm = _random_costmap(rng)
         ax, ay = _inside(rng, cm, 25)
         bx, by = ax + rng.normal(0, 2 * cm.res_m, 25), ay + rng.normal(0, 2 * cm.res_m, 25)
-        for a0, a1, b0, b1 in zip(ax, ay, bx, by):
+        for a0, a1, b0, b1 in zip(ax, ay, bx, by, strict=True):
             n = 4001
             t = np.linspace(0.0, 1.0, n)
             d = _brute(cm, a0 + t * (b0 - a0), a1 + t * (b1 - a1))
@@ -174,7 +174,7 @@ def test_arc_distance_and_clear_agree_with_brute_force():
     for _ in range(25):
         cm = _random_costmap(rng)
         xs, ys = _inside(rng, cm, 12)
-        for x, y in zip(xs, ys):
+        for x, y in zip(xs, ys, strict=True):
             th = float(rng.uniform(-math.pi, math.pi))
             v = float(rng.uniform(-1.0, 2.0)) * cm.res_m * 4
             w = float(rng.choice([0.0, rng.uniform(-3.0, 3.0)]))
@@ -198,7 +198,7 @@ def test_field_distance_is_a_lower_bound_and_the_edge_exact():
         cm = _random_costmap(rng)
         xs, ys = _inside(rng, cm, 80)
         want = _brute_squares(cm, xs, ys)
-        for x, y, d in zip(xs, ys, want):
+        for x, y, d in zip(xs, ys, want, strict=True):
             sq, edge = field_distance(cm, float(x), float(y))
             assert sq <= d + 1e-12
             # and not far below it: within a lattice cell's diagonal

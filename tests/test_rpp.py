@@ -13,6 +13,7 @@ import pytest
 
 import pathfuse
 from pathfuse import simulate
+from pathfuse.costmap import make_costmap
 from pathfuse.grid import GridMap
 from pathfuse.planners.controllers.follow import FollowController, ReplanController
 from pathfuse.planners.controllers.rpp import (
@@ -60,7 +61,12 @@ ORG = -5.0
 def _step(path, x, y, th, v0=0.0, w0=0.0, i0=0, s0=0.0, occ=FREE, cfg=None):
     path = np.ascontiguousarray(path, dtype=np.float64)
     cfg = _cfg() if cfg is None else cfg
-    return rpp_step(path, _cum(path), occ, ORG, ORG, 0.1, cfg, x, y, th, v0, w0, i0, s0)
+    cm = make_costmap(occ, 0.2, origin=(ORG, ORG), resolution_m=0.1)
+    return rpp_step(path, _cum(path), cm, cfg, x, y, th, v0, w0, i0, s0)
+
+
+def _cm(occ):
+    return make_costmap(occ, 0.2, origin=(ORG, ORG), resolution_m=0.1)
 
 
 # ----------------------------------------------------------------------------- geometry
@@ -215,10 +221,10 @@ def test_an_arc_through_a_wall_shortens_the_lookahead():
     far = _step(path, x, y, th, v0=1.0, occ=occ, cfg=_cfg(clear_carrot=False))
     near = _step(path, x, y, th, v0=1.0, occ=occ)
     assert math.hypot(far[5] - x, far[6] - y) == pytest.approx(0.9)
-    assert not carrot_is_clear(occ, ORG, ORG, 0.1, x, y, th, *_frame(far[5], far[6], x, y, th),
+    assert not carrot_is_clear(_cm(occ), x, y, th, *_frame(far[5], far[6], x, y, th),
                                0.785, 0.2)
     assert math.hypot(near[5] - x, near[6] - y) < 0.9
-    assert carrot_is_clear(occ, ORG, ORG, 0.1, x, y, th, *_frame(near[5], near[6], x, y, th),
+    assert carrot_is_clear(_cm(occ), x, y, th, *_frame(near[5], near[6], x, y, th),
                            0.785, 0.2)
     assert near[4] == MODE_PURSUIT and near[0] > 0
 

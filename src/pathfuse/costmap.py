@@ -240,10 +240,6 @@ def make_costmap(occupied: Any, radius_m: float, *, origin: Any = None,
     ...                   field_cell_m=0.05)
     >>> cm.field.shape, cm.field_res_m
     ((4, 4), 0.05)
-    >>> make_costmap(np.zeros((2, 2)), 0.25)
-    Traceback (most recent call last):
-    ...
-    pathfuse.result.ConfigError: occupied: must be a 2-D bool array or a GridMap, got float64 array of shape (2, 2)
     >>> make_costmap(np.zeros((2, 2), dtype=np.bool_), 0.25, resolution_m=0)
     Traceback (most recent call last):
     ...

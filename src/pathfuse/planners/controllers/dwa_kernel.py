@@ -13,6 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
+from pathfuse.costmap import Discs
 from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
 from pathfuse.sweep import (
@@ -446,6 +447,7 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chos
     dspeed = np.empty(n_disc)
     for j in range(n_disc):
         dspeed[j] = math.hypot(dvel[j, 0], dvel[j, 1])
+    discs = Discs(dpos, dvel, dspeed, drad)
     nd = drad.shape[0]
     sides = np.zeros((nd, 2))
     for j in range(nd):
@@ -483,7 +485,7 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chos
                          ty, dside, sides)
                 if out[1] == 1.0 and n_disc > 0:
                     out[0] += _passive_penalty(holonomic_stop_disc_gap(
-                        x, y, ux, uy, dt, amax, f[D_RADIUS], dpos, dspeed, drad))
+                        x, y, ux, uy, dt, amax, f[D_RADIUS], discs))
                 if out[1] == 1.0:
                     count += 1
                     if out[0] < best:
@@ -514,7 +516,7 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chos
                      dside, sides)
             if out[1] == 1.0 and n_disc > 0:
                 out[0] += _passive_penalty(unicycle_stop_disc_gap(
-                    x, y, th, v, w, dt, amax, f[D_ALPHA], f[D_RADIUS], dpos, dspeed, drad))
+                    x, y, th, v, w, dt, amax, f[D_ALPHA], f[D_RADIUS], discs))
             if out[1] == 1.0:
                 count += 1
                 if out[0] < best:

@@ -86,7 +86,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from pathfuse.costmap import clearance_lattice
+from pathfuse.costmap import NO_DISCS, clearance_lattice, costmap_for
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.grid import GridMap
@@ -348,21 +348,16 @@ class MPPIController(Controller):
         from pathfuse.shield import ND, NV, NW, shield_holonomic, shield_unicycle
 
         rb = self.robot
-        g = self.problem.grid
-        ox, oy = float(g.origin[0]), float(g.origin[1])
-        z2, z1 = _NO_DISCS[0], _NO_DISCS[2]
-        r = float(self.problem.robot_radius_m)
+        cm = costmap_for(self.problem.grid, float(self.problem.robot_radius_m))
         if self.holonomic:
-            u, w, code = shield_holonomic(g.occupied, ox, oy, float(g.resolution), x, y, c0,
-                                          c1, a0, a1, self.tick_s, rb.max_speed_mps,
-                                          rb.max_accel_mps2, self.clear_m, r, z2, z1, z1, 0.0,
+            u, w, code = shield_holonomic(cm, x, y, c0, c1, a0, a1, self.tick_s,
+                                          rb.max_speed_mps, rb.max_accel_mps2, NO_DISCS, 0.0,
                                           ND)
         else:
-            u, w, code = shield_unicycle(g.occupied, ox, oy, float(g.resolution), x, y, th, c0,
-                                         c1, a0, a1, self.tick_s, rb.min_speed_mps,
-                                         rb.max_speed_mps, rb.max_accel_mps2,
-                                         rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2,
-                                         self.clear_m, r, z2, z1, z1, 0.0, NV, NW)
+            u, w, code = shield_unicycle(cm, x, y, th, c0, c1, a0, a1, self.tick_s,
+                                         rb.min_speed_mps, rb.max_speed_mps,
+                                         rb.max_accel_mps2, rb.max_yaw_rate_radps,
+                                         rb.max_yaw_accel_radps2, NO_DISCS, 0.0, NV, NW)
         self.offline_shield[code] += 1
         return float(u), float(w)
 

@@ -20,6 +20,7 @@ from pathfuse.planners.controllers.rpp import (
     CARROT_MARGIN_M,
     MODE_PURSUIT,
     MODE_ROTATE,
+    RppSettings,
     carrot_is_clear,
     carrot_point,
     closest_progress,
@@ -48,9 +49,9 @@ def _cum(path: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
 
 
-def _cfg(robot: RobotModel | None = None, res: float = 0.1, **kw: object) -> np.ndarray:
+def _cfg(robot: RobotModel | None = None, **kw: object) -> RppSettings:
     rb = robot or RobotModel.diff_drive(radius_m=0.2, max_speed_mps=1.0)
-    return pack_settings(PursuitParams(**kw), rb, DT, rb.max_speed_mps, rb.radius_m, res)
+    return pack_settings(PursuitParams(**kw), rb, DT, rb.max_speed_mps)
 
 
 # an empty 10 m x 10 m map with its origin at (-5, -5): the robot near (0, 0)

@@ -27,9 +27,8 @@ CUM = np.array([0.0, 14.0])
 def _settings(**social):
     pb = Problem.create(HALL, (1.0, 3.0), (15.0, 3.0), 0.2,
                         robot=RobotModel.diff_drive(radius_m=0.2))
-    f = ForceWindow(pb, 0.1, social=SocialParams(**social)).f.copy()
-    K.set_route(f, (1.0, 0.0))
-    return f
+    fw = ForceWindow(pb, 0.1, social=SocialParams(**social))
+    return fw.costmap, fw.f
 
 
 def _choose(f, disc_y, dside=0.0):
@@ -37,7 +36,9 @@ def _choose(f, disc_y, dside=0.0):
     dvel = np.array([[-0.6, 0.0]])
     drad = np.array([0.3])
     chosen = np.zeros((1, 2))
-    a0, a1, count, _ = K.dwa_choose(HALL.occupied, f, 4.0, 3.0, 0.0, 0.8, 0.0, PTS, CUM, 0,
+    cm, s = f
+    tick = K.DwaTick(np.inf, 1.0, 0.0)  # the route along +x
+    a0, a1, count, _ = K.dwa_choose(cm, s, tick, 4.0, 3.0, 0.0, 0.8, 0.0, PTS, CUM, 0,
                                     dpos, dvel, drad, np.array([dside]), chosen)
     assert count > 0
     return a0, a1, chosen[0]

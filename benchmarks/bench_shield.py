@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.costmap import NO_DISCS, costmap_for
 from pathfuse.planners.drive import admissible
 from pathfuse.shield import CODE_NAMES, shield_unicycle, warmup_shield
 from pathfuse.studies.barn import BarnConfig, _scenario, find_worlds, jackal_robot
@@ -66,7 +66,6 @@ def main() -> None:
     warmup_shield()
     data, decide = states()
     rng = np.random.default_rng(0)
-    z2, z1 = np.zeros((0, 2)), np.zeros(0)
     rows: dict[str, list[float]] = {"shield (asked)": [], "shield (adversarial)": [],
                                     "straight-stop check": []}
     codes = np.zeros(5, dtype=np.int64)
@@ -75,8 +74,8 @@ def main() -> None:
     for sc, p, th, prev, cmd in data:
         g = sc.grid
         rb = sc.robot.to_model()
-        occ, ox, oy, res = g.occupied, float(g.origin[0]), float(g.origin[1]), g.resolution
-        clear = rb.radius_m + MARGIN_FRAC * res
+        cm = costmap_for(g, rb.radius_m)
+        clear = cm.clear_m
         lim = (rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2, rb.max_yaw_rate_radps,
                rb.max_yaw_accel_radps2)
         adv = (rb.max_speed_mps, float(rng.uniform(-1, 1)) * rb.max_yaw_rate_radps)
@@ -84,9 +83,9 @@ def main() -> None:
             best = np.inf
             for _ in range(a.repeat):
                 t0 = time.perf_counter()
-                out = shield_unicycle(occ, ox, oy, res, float(p[0]), float(p[1]), th,
+                out = shield_unicycle(cm, float(p[0]), float(p[1]), th,
                                       float(prev[0]), float(prev[1]), float(v), float(w),
-                                      float(sc.dt), *lim, clear, rb.radius_m, z2, z1, z1, 0.0)
+                                      float(sc.dt), *lim, NO_DISCS, 0.0)
                 best = min(best, time.perf_counter() - t0)
             rows[name].append(best)
             if name == "shield (adversarial)":
@@ -95,7 +94,7 @@ def main() -> None:
         best = np.inf
         for _ in range(a.repeat):
             t0 = time.perf_counter()
-            admissible(occ, ox, oy, res, float(p[0]), float(p[1]), th, v, w, float(sc.dt),
+            admissible(cm, float(p[0]), float(p[1]), th, v, w, float(sc.dt),
                        v * v / (2.0 * rb.max_accel_mps2), clear)
             best = min(best, time.perf_counter() - t0)
         rows["straight-stop check"].append(best)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from pathfuse import ConfigError, simulate
+from pathfuse.costmap import make_costmap
 from pathfuse.planners.drive import unicycle_command
 from pathfuse.planners.registry import get_planner, planner_names
 from pathfuse.robot import DIFF_DRIVE_DEFAULTS, RobotModel
@@ -156,7 +157,7 @@ def test_a_diff_drive_robot_cutting_a_corner_on_an_arc_collides():
     w = World(sc)
     w.reset()
     x1, y1, _ = unicycle_pose(3.0, 0.55, 1.0, 2.0, -2.0, 1.0)
-    chord = segment_static_distance(w._occ, 0.0, 0.0, 1.0, 3.0, 0.55, x1, y1, 5.0)
+    chord = segment_static_distance(w.costmap.occ, 0.0, 0.0, 1.0, 3.0, 0.55, x1, y1, 5.0)
     assert chord > 0.4   # the chord alone misses by far
     _, term, _, info = w.step((2.0, -2.0))
     assert term and info["collision"] == "static" and info["static_gap"] < 0
@@ -177,21 +178,22 @@ def test_robot_model_and_block_round_trip():
 def test_unicycle_command_stays_in_the_window_and_brakes_for_walls():
     occ = np.zeros((10, 10), dtype=np.bool_)
     occ[:, 6] = True   # a wall at x = 6
+    cm = make_costmap(occ, 0.2, clear_m=0.2)
     rng = np.random.default_rng(3)
     for _ in range(300):
         v0, w0 = rng.uniform(0, 1), rng.uniform(-2, 2)
         ux, uy = rng.uniform(-1, 1, 2)
-        v, w = unicycle_command(occ, 0.0, 0.0, 1.0, 3.0, 5.0, rng.uniform(-3, 3), v0, w0, ux,
-                                uy, 0.1, 0.0, 1.0, 2.0, 2.0, 4.0, 0.2)
+        v, w = unicycle_command(cm, 3.0, 5.0, rng.uniform(-3, 3), v0, w0, ux,
+                                uy, 0.1, 0.0, 1.0, 2.0, 2.0, 4.0)
         assert max(0.0, v0 - 0.2) - 1e-12 <= v <= min(1.0, v0 + 0.2) + 1e-12
         assert max(-2.0, w0 - 0.4) - 1e-12 <= w <= min(2.0, w0 + 0.4) + 1e-12
     # heading at the wall with a 0.2 m gap at 0.8 m/s: brakes so that it can stop in time
-    v, _ = unicycle_command(occ, 0.0, 0.0, 1.0, 5.6, 5.0, 0.0, 0.8, 0.0, 1.0, 0.0, 0.1, 0.0,
-                            1.0, 2.0, 2.0, 4.0, 0.2)
+    v, _ = unicycle_command(cm, 5.6, 5.0, 0.0, 0.8, 0.0, 1.0, 0.0, 0.1, 0.0,
+                            1.0, 2.0, 2.0, 4.0)
     assert v < 0.8 and v * 0.1 + v * v / 4.0 <= 0.2
     # with a 0.3 m gap it may still speed up: 0.09 m this tick + 0.2025 m to stop fit
-    v, _ = unicycle_command(occ, 0.0, 0.0, 1.0, 5.5, 5.0, 0.0, 0.8, 0.0, 1.0, 0.0, 0.1, 0.0,
-                            1.0, 2.0, 2.0, 4.0, 0.2)
+    v, _ = unicycle_command(cm, 5.5, 5.0, 0.0, 0.8, 0.0, 1.0, 0.0, 0.1, 0.0,
+                            1.0, 2.0, 2.0, 4.0)
     assert v == pytest.approx(0.9)
 
 

@@ -13,12 +13,14 @@ import pytest
 
 import pathfuse
 from pathfuse import simulate
+from pathfuse.costmap import make_costmap
 from pathfuse.grid import GridMap
 from pathfuse.planners.controllers.follow import FollowController, ReplanController
 from pathfuse.planners.controllers.rpp import (
     CARROT_MARGIN_M,
     MODE_PURSUIT,
     MODE_ROTATE,
+    RppSettings,
     carrot_is_clear,
     carrot_point,
     closest_progress,
@@ -47,9 +49,9 @@ def _cum(path: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
 
 
-def _cfg(robot: RobotModel | None = None, res: float = 0.1, **kw: object) -> np.ndarray:
+def _cfg(robot: RobotModel | None = None, **kw: object) -> RppSettings:
     rb = robot or RobotModel.diff_drive(radius_m=0.2, max_speed_mps=1.0)
-    return pack_settings(PursuitParams(**kw), rb, DT, rb.max_speed_mps, rb.radius_m, res)
+    return pack_settings(PursuitParams(**kw), rb, DT, rb.max_speed_mps)
 
 
 # an empty 10 m x 10 m map with its origin at (-5, -5): the robot near (0, 0)
@@ -60,7 +62,12 @@ ORG = -5.0
 def _step(path, x, y, th, v0=0.0, w0=0.0, i0=0, s0=0.0, occ=FREE, cfg=None):
     path = np.ascontiguousarray(path, dtype=np.float64)
     cfg = _cfg() if cfg is None else cfg
-    return rpp_step(path, _cum(path), occ, ORG, ORG, 0.1, cfg, x, y, th, v0, w0, i0, s0)
+    cm = make_costmap(occ, 0.2, origin=(ORG, ORG), resolution_m=0.1)
+    return rpp_step(path, _cum(path), cm, cfg, x, y, th, v0, w0, i0, s0)
+
+
+def _cm(occ):
+    return make_costmap(occ, 0.2, origin=(ORG, ORG), resolution_m=0.1)
 
 
 # ----------------------------------------------------------------------------- geometry
@@ -215,10 +222,10 @@ def test_an_arc_through_a_wall_shortens_the_lookahead():
     far = _step(path, x, y, th, v0=1.0, occ=occ, cfg=_cfg(clear_carrot=False))
     near = _step(path, x, y, th, v0=1.0, occ=occ)
     assert math.hypot(far[5] - x, far[6] - y) == pytest.approx(0.9)
-    assert not carrot_is_clear(occ, ORG, ORG, 0.1, x, y, th, *_frame(far[5], far[6], x, y, th),
+    assert not carrot_is_clear(_cm(occ), x, y, th, *_frame(far[5], far[6], x, y, th),
                                0.785, 0.2)
     assert math.hypot(near[5] - x, near[6] - y) < 0.9
-    assert carrot_is_clear(occ, ORG, ORG, 0.1, x, y, th, *_frame(near[5], near[6], x, y, th),
+    assert carrot_is_clear(_cm(occ), x, y, th, *_frame(near[5], near[6], x, y, th),
                            0.785, 0.2)
     assert near[4] == MODE_PURSUIT and near[0] > 0
 

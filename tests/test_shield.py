@@ -12,6 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from pathfuse.costmap import Discs, make_costmap
 from pathfuse.planners.base import Controller
 from pathfuse.planners.drive import admissible
 from pathfuse.problem import Problem
@@ -75,6 +76,18 @@ def brute_stop(occ, res, x, y, th, v, w, dt, amax, alpha):
 # ----------------------------------------------------------------------------- the stop
 
 
+def _cm(occ, res=1.0, clear=0.3):
+    """The costmap of a test map: radius and clearance ``clear``."""
+    return make_costmap(occ, clear, resolution_m=res, clear_m=clear)
+
+
+def _discs(pos, speed, radius):
+    return Discs(pos, pos, speed, radius)
+
+
+NONE = Discs(np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0))
+
+
 def test_unicycle_stop_agrees_with_brute_force():
     rng = np.random.default_rng(0)
     res = 0.25
@@ -86,7 +99,7 @@ def test_unicycle_stop_agrees_with_brute_force():
         v, w = rng.uniform(-1.0, 2.5), rng.uniform(-2.5, 2.5)
         dt, amax, alpha = rng.uniform(0.05, 0.3), rng.uniform(0.5, 4), rng.uniform(1, 8)
         clear = rng.uniform(0.05, 0.4)
-        got = unicycle_stop_clear(occ, 0.0, 0.0, res, x, y, th, v, w, dt, amax, alpha, clear)
+        got = unicycle_stop_clear(_cm(occ, res, clear), x, y, th, v, w, dt, amax, alpha, clear)
         md, _ = brute_stop(occ, res, x, y, th, v, w, dt, amax, alpha)
         # dense sampling overestimates the least clearance by at most half a sample spacing
         slack = abs(v) * dt / 200
@@ -131,8 +144,9 @@ def test_a_straight_stop_can_clear_where_every_real_stop_hits():
     occ[20:, 20:] = True
     args = (1.0, 0.8, -2.711, 1.603, 1.845, 0.1)
     v = args[3]
-    assert admissible(occ, 0.0, 0.0, 0.1, *args, v * v / 4.0, 0.333)
-    assert not unicycle_stop_clear(occ, 0.0, 0.0, 0.1, *args, 2.0, 4.0, 0.333)
+    cm = _cm(occ, 0.1, 0.333)
+    assert admissible(cm, *args, v * v / 4.0, 0.333)
+    assert not unicycle_stop_clear(cm, *args, 2.0, 4.0, 0.333)
     md, _ = brute_stop(occ, 0.1, *args, 2.0, 4.0)
     assert md < 0.333
 
@@ -141,47 +155,46 @@ def test_holonomic_stop_without_acceleration_limit_is_the_tick_alone():
     occ = np.zeros((10, 10), dtype=np.bool_)
     occ[:, 6] = True
     # 1 m/s for 0.5 s from x = 5.1 ends at 5.6, 0.4 m from the wall: clear with radius 0.3
-    assert holonomic_stop_clear(occ, 0.0, 0.0, 1.0, 5.1, 5.0, 1.0, 0.0, 0.5, math.inf, 0.3)
+    assert holonomic_stop_clear(_cm(occ), 5.1, 5.0, 1.0, 0.0, 0.5, math.inf, 0.3)
     # with 1 m/s^2 it also brakes 0.25 m (0.5 m/s for one more tick): not clear
-    assert not holonomic_stop_clear(occ, 0.0, 0.0, 1.0, 5.1, 5.0, 1.0, 0.0, 0.5, 1.0, 0.3)
+    assert not holonomic_stop_clear(_cm(occ), 5.1, 5.0, 1.0, 0.0, 0.5, 1.0, 0.3)
 
 
 def test_shield_codes():
     occ = np.zeros((10, 10), dtype=np.bool_)
     occ[:, 6] = True
-    z2, z1 = np.zeros((0, 2)), np.zeros(0)
     lim = (0.0, 1.0, 1.0, 2.0, 4.0)
-    v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, z2, z1, z1, 0.0)
+    v, w, code = shield_unicycle(_cm(occ), 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
+                                 *lim, NONE, 0.0)
     assert (v, w, code) == (1.0, 0.0, ASKED)
     # facing the wall at full speed, 0.4 m from it: brake (and turn away)
-    v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 5.3, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, z2, z1, z1, 0.0)
+    v, w, code = shield_unicycle(_cm(occ), 5.3, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
+                                 *lim, NONE, 0.0)
     assert code == NEAREST and v < 1.0
-    assert unicycle_stop_clear(occ, 0.0, 0.0, 1.0, 5.3, 5.0, 0.0, v, w, 0.5, 1.0, 4.0, 0.3)
+    assert unicycle_stop_clear(_cm(occ), 5.3, 5.0, 0.0, v, w, 0.5, 1.0, 4.0, 0.3)
     # too close already: no clear command exists; the emergency stop is returned
-    v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 5.5, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, z2, z1, z1, 0.0)
+    v, w, code = shield_unicycle(_cm(occ), 5.5, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
+                                 *lim, NONE, 0.0)
     assert code == UNSAFE and v == 0.5
     # a disc 2 m ahead that may come at 1 m/s: going on at 1 m/s, the robot could not stop
     # before the disc can reach it; the shield brakes and turns away until it can
     dp, ds, dr = np.array([[4.0, 5.0]]), np.array([1.0]), np.array([0.3])
-    gap = unicycle_stop_disc_gap(2.0, 5.0, 0.0, 1.0, 0.0, 0.5, 1.0, 4.0, 0.3, dp, ds, dr)
+    gap = unicycle_stop_disc_gap(2.0, 5.0, 0.0, 1.0, 0.0, 0.5, 1.0, 4.0, 0.3, _discs(dp, ds, dr))
     assert gap < 0
-    v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, dp, ds, dr, 0.0)
+    v, w, code = shield_unicycle(_cm(occ), 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
+                                 *lim, _discs(dp, ds, dr), 0.0)
     assert code == NEAREST and v < 1.0 and w != 0.0
-    assert unicycle_stop_disc_gap(2.0, 5.0, 0.0, v, w, 0.5, 1.0, 4.0, 0.3, dp, ds, dr) >= 0
+    assert unicycle_stop_disc_gap(2.0, 5.0, 0.0, v, w, 0.5, 1.0, 4.0, 0.3, _discs(dp, ds, dr)) >= 0
     # 1.2 m ahead no stop can keep clear of where it may be: the largest gap (evade)
-    v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, dp - [0.8, 0.0], ds, dr, 0.0)
+    v, w, code = shield_unicycle(_cm(occ), 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
+                                 *lim, _discs(dp - [0.8, 0.0], ds, dr), 0.0)
     assert code == EVADE and v == 0.5
     # far enough away, the asked command passes
-    v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
-                                 *lim, 0.3, 0.3, dp + [0.0, 3.0], ds, dr, 0.0)
+    v, w, code = shield_unicycle(_cm(occ), 2.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.5,
+                                 *lim, _discs(dp + [0.0, 3.0], ds, dr), 0.0)
     assert code == ASKED
-    ux, uy, code = shield_holonomic(occ, 0.0, 0.0, 1.0, 5.5, 5.0, 0.0, 0.0, 1.0, 0.0, 0.5, 1.0,
-                                    math.inf, 0.3, 0.3, z2, z1, z1, 0.0)
+    ux, uy, code = shield_holonomic(_cm(occ), 5.5, 5.0, 0.0, 0.0, 1.0, 0.0, 0.5, 1.0,
+                                    math.inf, NONE, 0.0)
     assert code == NEAREST and 5.5 + ux * 0.5 + 0.3 <= 6.0
 
 

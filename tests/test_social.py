@@ -27,9 +27,8 @@ CUM = np.array([0.0, 14.0])
 def _settings(**social):
     pb = Problem.create(HALL, (1.0, 3.0), (15.0, 3.0), 0.2,
                         robot=RobotModel.diff_drive(radius_m=0.2))
-    f = ForceWindow(pb, 0.1, social=SocialParams(**social)).f.copy()
-    K.set_route(f, (1.0, 0.0))
-    return f
+    fw = ForceWindow(pb, 0.1, social=SocialParams(**social))
+    return fw.costmap, fw.f
 
 
 def _choose(f, disc_y, dside=0.0):
@@ -37,7 +36,9 @@ def _choose(f, disc_y, dside=0.0):
     dvel = np.array([[-0.6, 0.0]])
     drad = np.array([0.3])
     chosen = np.zeros((1, 2))
-    a0, a1, count, _ = K.dwa_choose(HALL.occupied, f, 4.0, 3.0, 0.0, 0.8, 0.0, PTS, CUM, 0,
+    cm, s = f
+    tick = K.DwaTick(np.inf, 1.0, 0.0)  # the route along +x
+    a0, a1, count, _ = K.dwa_choose(cm, s, tick, 4.0, 3.0, 0.0, 0.8, 0.0, PTS, CUM, 0,
                                     dpos, dvel, drad, np.array([dside]), chosen)
     assert count > 0
     return a0, a1, chosen[0]
@@ -167,11 +168,11 @@ def test_dwell_critic_is_switchable_and_off_by_default_in_dwa_and_mppi():
     assert get_planner("fusion").defaults()["dwell_s"] == 1.5
     assert get_planner("dwa").defaults()["dwell_s"] == 0.0
     assert get_planner("mppi").defaults()["dwell_s"] == 0.0
-    f = _settings()
-    assert f[K.D_DWELL] == 0.0  # the window's settings: the fusion's default social params
-    f = _settings(dwell_s=2.0)
-    assert (f[K.D_DWELL], f[K.D_WDWELL]) == (2.0, 50.0)
-    assert _settings(dwell_s=2.0, social=False)[K.D_DWELL] == 0.0
+    _, s = _settings()
+    assert s.dwell_s == 0.0  # SocialParams' own default (off)
+    _, s = _settings(dwell_s=2.0)
+    assert (s.dwell_s, s.dwell_weight) == (2.0, 50.0)
+    assert _settings(dwell_s=2.0, social=False)[1].dwell_s == 0.0
 
 
 def test_dwell_critic_moves_dwa_out_of_a_walkers_lane():
@@ -183,10 +184,11 @@ def test_dwell_critic_moves_dwa_out_of_a_walkers_lane():
     drad = np.array([0.3])
 
     def speed(**social):
-        f = _settings(**social)
+        cm, s = _settings(**social)
         chosen = np.zeros((1, 2))
-        a0, a1, count, _ = K.dwa_choose(HALL.occupied, f, 4.0, 3.0, 0.0, 0.8, 0.0, PTS, CUM,
-                                        0, dpos, dvel, drad, np.array([0.0]), chosen)
+        tick = K.DwaTick(np.inf, 1.0, 0.0)  # the route along +x
+        a0, a1, count, _ = K.dwa_choose(cm, s, tick, 4.0, 3.0, 0.0, 0.8, 0.0, PTS, CUM, 0,
+                                        dpos, dvel, drad, np.array([0.0]), chosen)
         assert count > 0
         return a0
 

@@ -15,9 +15,9 @@ The stop (:func:`unicycle_stop_clear`, :func:`holonomic_stop_clear`)
     footprint survives.  Holonomic: the velocity vector shrinks by ``a dt``
     per tick along a straight line (at once without an acceleration limit).
     Each tick's sweep is checked exactly against the occupied squares and the
-    map's edge (:func:`~pathfuse.sweep.arc_static_distance`, which never
-    misses a contact), keeping ``clear`` (the radius plus a millionth of a
-    cell).
+    map's edge of the :class:`~pathfuse.costmap.Costmap`
+    (:func:`~pathfuse.costmap.arc_distance`, which never misses a contact),
+    keeping its ``clear_m`` (the radius plus a millionth of a cell).
 
 The choice (:func:`shield_unicycle`, :func:`shield_holonomic`)
     1. the controller's command, clipped to the window as the world clips it,
@@ -56,17 +56,22 @@ too close, or a disc pushed it there; the emergency stop is returned) and
 :data:`EVADE` (statically safe, but a predicted disc contact could not be
 avoided; the command with the largest predicted gap).
 
+The static map and the robot's disc come as one :class:`~pathfuse.costmap.Costmap`
+(``clear_m`` is kept from the squares, ``radius_m`` from the moving discs), the
+moving discs as one :class:`~pathfuse.costmap.Discs`.
+
 Examples
 --------
 >>> import numpy as np
+>>> from pathfuse.costmap import NO_DISCS, make_costmap
 >>> occ = np.zeros((10, 10), dtype=np.bool_); occ[:, 6] = True   # a wall at x = 6
->>> z2, z1 = np.zeros((0, 2)), np.zeros(0)
+>>> cm = make_costmap(occ, 0.3, clear_m=0.3)
 >>> # 1 m/s, 1 m/s^2, dt 0.5, radius 0.3, at x = 5 heading for the wall at full speed:
 >>> # a full-speed tick and the stop after it would end 0.05 m inside the wall
->>> bool(unicycle_stop_clear(occ, 0.0, 0.0, 1.0, 5.0, 5.0, 0.0, 1.0, 0.0, 0.5, 1.0, 4.0, 0.3))
+>>> bool(unicycle_stop_clear(cm, 5.0, 5.0, 0.0, 1.0, 0.0, 0.5, 1.0, 4.0, 0.3))
 False
->>> v, w, code = shield_unicycle(occ, 0.0, 0.0, 1.0, 5.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0,
-...                              0.5, 0.0, 1.0, 1.0, 2.0, 4.0, 0.3, 0.3, z2, z1, z1, 0.0)
+>>> v, w, code = shield_unicycle(cm, 5.0, 5.0, 0.0, 1.0, 0.0, 1.0, 0.0,
+...                              0.5, 0.0, 1.0, 1.0, 2.0, 4.0, NO_DISCS, 0.0, NV, NW)
 >>> round(v, 6), round(w, 6), CODE_NAMES[code]   # the nearest command that can still stop
 (0.916667, 0.0, 'nearest')
 """
@@ -78,13 +83,8 @@ import math
 import numpy as np
 from numba import njit
 
-from pathfuse.sweep import (
-    arc_disc_gaps,
-    arc_static_distance,
-    disc_sweep_gaps,
-    segment_static_distance,
-    unicycle_pose,
-)
+from pathfuse.costmap import Costmap, Discs, arc_distance, point_distance, segment_distance
+from pathfuse.sweep import arc_disc_gaps, disc_sweep_gaps, unicycle_pose
 
 __all__ = [
     "ASKED", "NEAREST", "EMERGENCY", "UNSAFE", "EVADE", "CODE_NAMES",
@@ -163,14 +163,13 @@ def _stop_ticks(v: float, amax: float, dt: float) -> int:
 
 
 @njit(cache=True)
-def unicycle_stop_clear(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
-                        th: float, v: float, w: float, dt: float, amax: float, alpha: float,
-                        clear: float) -> bool:
+def unicycle_stop_clear(cm: Costmap, x: float, y: float, th: float, v: float, w: float,
+                        dt: float, amax: float, alpha: float, clear: float) -> bool:
     """Whether ``(v, w)`` for one tick from ``(x, y, th)``, then the stop (see the module
     docstring), keeps the disc ``clear`` from every occupied square and the map's edge."""
     n = _stop_ticks(v, amax, dt)
     for _ in range(n):
-        d = arc_static_distance(occ, ox, oy, res, x, y, th, v, w, dt, clear, clear)
+        d = arc_distance(cm, x, y, th, v, w, dt, clear, clear)
         if d < clear:
             return False
         if v == 0.0:
@@ -182,9 +181,8 @@ def unicycle_stop_clear(occ: np.ndarray, ox: float, oy: float, res: float, x: fl
 
 
 @njit(cache=True)
-def holonomic_stop_clear(occ: np.ndarray, ox: float, oy: float, res: float, x: float,
-                         y: float, ux: float, uy: float, dt: float, amax: float,
-                         clear: float) -> bool:
+def holonomic_stop_clear(cm: Costmap, x: float, y: float, ux: float, uy: float, dt: float,
+                         amax: float, clear: float) -> bool:
     """Whether the velocity ``(ux, uy)`` for one tick, then a straight stop shrinking it by
     ``amax dt`` per tick, keeps the disc ``clear`` from the static map."""
     s = math.sqrt(ux * ux + uy * uy)
@@ -192,7 +190,7 @@ def holonomic_stop_clear(occ: np.ndarray, ox: float, oy: float, res: float, x: f
     for _ in range(n):
         bx = x + ux * dt
         by = y + uy * dt
-        if segment_static_distance(occ, ox, oy, res, x, y, bx, by, clear) < clear:
+        if segment_distance(cm, x, y, bx, by, clear) < clear:
             return False
         if s == 0.0:
             return True
@@ -206,11 +204,13 @@ def holonomic_stop_clear(occ: np.ndarray, ox: float, oy: float, res: float, x: f
 
 @njit(cache=True)
 def unicycle_stop_disc_gap(x: float, y: float, th: float, v: float, w: float, dt: float,
-                           amax: float, alpha: float, radius: float, dpos: np.ndarray,
-                           dspeed: np.ndarray, drad: np.ndarray) -> float:
+                           amax: float, alpha: float, radius: float, discs: Discs) -> float:
     """The least gap, while the robot moves over the command's tick and its stop, to the
-    places the discs can reach: disc ``i`` anywhere within ``dspeed[i] t`` of where it is
-    now (``inf`` without discs or when the robot does not move)."""
+    places the discs can reach: disc ``i`` anywhere within ``speed_bound_mps[i] t`` of where
+    it is now (``inf`` without discs or when the robot does not move)."""
+    dpos = discs.pos_m
+    dspeed = discs.speed_bound_mps
+    drad = discs.radius_m
     best = np.inf
     if dpos.shape[0] == 0:
         return best
@@ -232,9 +232,11 @@ def unicycle_stop_disc_gap(x: float, y: float, th: float, v: float, w: float, dt
 
 @njit(cache=True)
 def holonomic_stop_disc_gap(x: float, y: float, ux: float, uy: float, dt: float, amax: float,
-                            radius: float, dpos: np.ndarray, dspeed: np.ndarray,
-                            drad: np.ndarray) -> float:
+                            radius: float, discs: Discs) -> float:
     """As :func:`unicycle_stop_disc_gap` for the holonomic robot's straight stop."""
+    dpos = discs.pos_m
+    dspeed = discs.speed_bound_mps
+    drad = discs.radius_m
     best = np.inf
     if dpos.shape[0] == 0:
         return best
@@ -263,36 +265,37 @@ def holonomic_stop_disc_gap(x: float, y: float, ux: float, uy: float, dt: float,
 
 
 @njit(cache=True)
-def _here_clear(occ, ox, oy, res, x, y, clear):
+def _here_clear(cm, x, y, clear):
     """``clear``, or the present clearance when the robot is already closer (it may keep
     what it has, never come closer)."""
-    d = segment_static_distance(occ, ox, oy, res, x, y, x, y, clear)
+    d = point_distance(cm, x, y, clear)
     if d < clear:
         return d * (1.0 - 1e-12)
     return clear
 
 
 @njit(cache=True)
-def shield_unicycle(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
-                    th: float, v0: float, w0: float, v: float, w: float, dt: float,
-                    vmin: float, vmax: float, amax: float, wmax: float, alpha: float,
-                    clear: float, radius: float, dpos: np.ndarray, dspeed: np.ndarray,
-                    drad: np.ndarray, disc_margin: float, nv: int = NV,
-                    nw: int = NW) -> tuple[float, float, int]:
+def shield_unicycle(cm: Costmap, x: float, y: float, th: float, v0: float, w0: float,
+                    v: float, w: float, dt: float, vmin: float, vmax: float, amax: float,
+                    wmax: float, alpha: float, discs: Discs, disc_margin: float,
+                    nv: int = NV, nw: int = NW) -> tuple[float, float, int]:
     """The shielded diff-drive command ``(v, w, code)`` (see the module docstring).
 
-    ``(x, y, th)`` is the pose, ``(v0, w0)`` the last applied command,
-    ``(v, w)`` the controller's; ``clear`` the static clearance to keep
-    (the radius plus a hair), ``radius`` the disc for the moving discs'
-    gaps; ``dpos``, ``dspeed``, ``drad`` the sensed discs' centres, speed bounds and radii.
+    ``cm`` is the static map with the robot's clearance ``cm.clear_m`` to keep
+    (the radius plus a hair) and its disc ``cm.radius_m`` for the moving discs'
+    gaps; ``(x, y, th)`` the pose, ``(v0, w0)`` the last applied command,
+    ``(v, w)`` the controller's; ``discs`` the sensed discs (centres, speed
+    bounds and radii are read).
     """
-    clear = _here_clear(occ, ox, oy, res, x, y, clear)
+    radius = cm.radius_m
+    dpos = discs.pos_m
+    clear = _here_clear(cm, x, y, cm.clear_m)
     v, w = clip_unicycle(v0, w0, v, w, dt, vmin, vmax, amax, wmax, alpha)
     nd = dpos.shape[0]
-    if unicycle_stop_clear(occ, ox, oy, res, x, y, th, v, w, dt, amax, alpha, clear):
+    if unicycle_stop_clear(cm, x, y, th, v, w, dt, amax, alpha, clear):
         if nd == 0:
             return v, w, ASKED
-        g = unicycle_stop_disc_gap(x, y, th, v, w, dt, amax, alpha, radius, dpos, dspeed, drad)
+        g = unicycle_stop_disc_gap(x, y, th, v, w, dt, amax, alpha, radius, discs)
         if g >= disc_margin:
             return v, w, ASKED
         best_g, best_v, best_w = g, v, w
@@ -329,13 +332,12 @@ def shield_unicycle(occ: np.ndarray, ox: float, oy: float, res: float, x: float,
         k = order[kk]
         vk = cv[k]
         wk = cw[k]
-        if not unicycle_stop_clear(occ, ox, oy, res, x, y, th, vk, wk, dt, amax, alpha, clear):
+        if not unicycle_stop_clear(cm, x, y, th, vk, wk, dt, amax, alpha, clear):
             continue
         code = EMERGENCY if k == m else NEAREST
         if nd == 0:
             return vk, wk, code
-        g = unicycle_stop_disc_gap(x, y, th, vk, wk, dt, amax, alpha, radius, dpos, dspeed,
-                                   drad)
+        g = unicycle_stop_disc_gap(x, y, th, vk, wk, dt, amax, alpha, radius, discs)
         if g >= disc_margin:
             return vk, wk, code
         if not found or g > best_g:
@@ -347,21 +349,21 @@ def shield_unicycle(occ: np.ndarray, ox: float, oy: float, res: float, x: float,
 
 
 @njit(cache=True)
-def shield_holonomic(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
-                     ux0: float, uy0: float, ux: float, uy: float, dt: float, vmax: float,
-                     amax: float, clear: float, radius: float, dpos: np.ndarray,
-                     dspeed: np.ndarray, drad: np.ndarray, disc_margin: float,
-                     nd: int = ND) -> tuple[float, float, int]:
+def shield_holonomic(cm: Costmap, x: float, y: float, ux0: float, uy0: float, ux: float,
+                     uy: float, dt: float, vmax: float, amax: float, discs: Discs,
+                     disc_margin: float, nd: int = ND) -> tuple[float, float, int]:
     """The shielded holonomic velocity ``(ux, uy, code)``: the asked velocity, else the
     nearest of ``nd`` directions x 4 speeds (each clipped as the world clips), else the
-    emergency stop (see the module docstring)."""
-    clear = _here_clear(occ, ox, oy, res, x, y, clear)
+    emergency stop (see the module docstring and :func:`shield_unicycle`)."""
+    radius = cm.radius_m
+    dpos = discs.pos_m
+    clear = _here_clear(cm, x, y, cm.clear_m)
     ux, uy = clip_holonomic(ux0, uy0, ux, uy, dt, vmax, amax)
     ndisc = dpos.shape[0]
-    if holonomic_stop_clear(occ, ox, oy, res, x, y, ux, uy, dt, amax, clear):
+    if holonomic_stop_clear(cm, x, y, ux, uy, dt, amax, clear):
         if ndisc == 0:
             return ux, uy, ASKED
-        g = holonomic_stop_disc_gap(x, y, ux, uy, dt, amax, radius, dpos, dspeed, drad)
+        g = holonomic_stop_disc_gap(x, y, ux, uy, dt, amax, radius, discs)
         if g >= disc_margin:
             return ux, uy, ASKED
         best_g, best_x, best_y = g, ux, uy
@@ -399,12 +401,12 @@ def shield_holonomic(occ: np.ndarray, ox: float, oy: float, res: float, x: float
         k = order[kk]
         px = cx[k]
         py = cy[k]
-        if not holonomic_stop_clear(occ, ox, oy, res, x, y, px, py, dt, amax, clear):
+        if not holonomic_stop_clear(cm, x, y, px, py, dt, amax, clear):
             continue
         code = EMERGENCY if k == m else NEAREST
         if ndisc == 0:
             return px, py, code
-        g = holonomic_stop_disc_gap(x, y, px, py, dt, amax, radius, dpos, dspeed, drad)
+        g = holonomic_stop_disc_gap(x, y, px, py, dt, amax, radius, discs)
         if g >= disc_margin:
             return px, py, code
         if not found or g > best_g:
@@ -416,24 +418,26 @@ def shield_holonomic(occ: np.ndarray, ox: float, oy: float, res: float, x: float
 
 
 def warmup_shield() -> None:
-    """Compile (or load from numba's cache) the shield for writeable and read-only maps and
-    disc arrays."""
+    """Compile (or load from numba's cache) the shield for writeable and read-only disc
+    arrays (a :class:`~pathfuse.costmap.Costmap`'s map is always read-only)."""
+    from pathfuse.costmap import make_costmap
+
+    occ = np.zeros((3, 3), dtype=np.bool_)
+    occ[1, 1] = True
+    cm = make_costmap(occ, 0.2, clear_m=0.2)
     for ro in (False, True):
-        occ = np.zeros((3, 3), dtype=np.bool_)
-        occ[1, 1] = True
         d2 = np.zeros((1, 2))
         d2[0] = (2.5, 2.5)
         v2 = np.full(1, 0.5)
         r1 = np.full(1, 0.1)
-        occ.setflags(write=not ro)
         for a in (d2, v2, r1):
             a.setflags(write=not ro)
         clip_unicycle(0.0, 0.0, 1.0, 0.5, 0.1, 0.0, 1.0, 2.0, 2.0, 4.0)
         clip_holonomic(0.0, 0.0, 1.0, 0.5, 0.1, 1.0, 2.0)
-        for dp, dv, dr in ((d2, v2, r1), (d2[:0], v2[:0], r1[:0])):
-            shield_unicycle(occ, 0.0, 0.0, 1.0, 0.5, 0.5, 0.0, 0.5, 0.0, 1.0, 0.5, 0.1, 0.0,
-                            1.0, 2.0, 2.0, 4.0, 0.2, 0.2, dp, dv, dr, 0.0, NV, NW)
-            shield_holonomic(occ, 0.0, 0.0, 1.0, 0.5, 0.5, 0.0, 0.0, 1.0, 0.5, 0.1, 1.0,
-                             2.0, 0.2, 0.2, dp, dv, dr, 0.0, ND)
-            shield_holonomic(occ, 0.0, 0.0, 1.0, 0.5, 0.5, 0.0, 0.0, 1.0, 0.5, 0.1, 1.0,
-                             math.inf, 0.2, 0.2, dp, dv, dr, 0.0, ND)
+        for ds in (Discs(d2, d2, v2, r1), Discs(d2[:0], d2[:0], v2[:0], r1[:0])):
+            shield_unicycle(cm, 0.5, 0.5, 0.0, 0.5, 0.0, 1.0, 0.5, 0.1, 0.0,
+                            1.0, 2.0, 2.0, 4.0, ds, 0.0, NV, NW)
+            shield_holonomic(cm, 0.5, 0.5, 0.0, 0.0, 1.0, 0.5, 0.1, 1.0,
+                             2.0, ds, 0.0, ND)
+            shield_holonomic(cm, 0.5, 0.5, 0.0, 0.0, 1.0, 0.5, 0.1, 1.0,
+                             math.inf, ds, 0.0, ND)

@@ -254,38 +254,34 @@ class Controller:
         return math.atan2(dy, dx) if dx or dy else None
 
     def _shielded(self, obs: Observed, a: np.ndarray) -> np.ndarray:
-        from pathfuse.geometry import MARGIN_FRAC
+        from pathfuse.costmap import Discs, costmap_for
         from pathfuse.shield import ND, NV, NW, shield_holonomic, shield_unicycle
 
         pb = self.problem
         rb = pb.robot
         assert rb is not None
-        g = pb.grid
-        ox, oy = float(g.origin[0]), float(g.origin[1])
-        res = float(g.resolution)
-        clear = float(pb.robot_radius_m) + MARGIN_FRAC * res
+        cm = costmap_for(pb.grid, float(pb.robot_radius_m))
         sens = obs.obstacles
         if len(sens):
             dp, dr = _plain(sens.positions), _plain(sens.radii)
-            dv = self._disc_speed_bounds(sens)
+            discs = Discs(dp, dp, self._disc_speed_bounds(sens), dr)
         else:
-            dp, dv, dr = _NO_DISCS[0], _NO_DISCS[2], _NO_DISCS[2]
+            discs = Discs(_NO_DISCS[0], _NO_DISCS[0], _NO_DISCS[2], _NO_DISCS[2])
         cmd = obs.command
         dt = float(self.dt)  # type: ignore[arg-type]
         if rb.is_diff_drive:
             u, w, code = shield_unicycle(
-                g.occupied, ox, oy, res, float(obs.position[0]), float(obs.position[1]),
+                cm, float(obs.position[0]), float(obs.position[1]),
                 float(obs.heading), float(cmd[0]), float(cmd[1]), float(a[0]), float(a[1]),
                 dt, float(rb.min_speed_mps), float(rb.max_speed_mps),
                 float(rb.max_accel_mps2), float(rb.max_yaw_rate_radps),
-                float(rb.max_yaw_accel_radps2), clear,
-                float(pb.robot_radius_m), dp, dv, dr, 0.0, NV, NW)
+                float(rb.max_yaw_accel_radps2), discs, 0.0, NV, NW)
         else:
             u, w, code = shield_holonomic(
-                g.occupied, ox, oy, res, float(obs.position[0]), float(obs.position[1]),
+                cm, float(obs.position[0]), float(obs.position[1]),
                 float(cmd[0]), float(cmd[1]), float(a[0]), float(a[1]), dt,
                 float(self.max_speed if self.max_speed is not None else rb.max_speed_mps),
-                float(rb.max_accel_mps2), clear, float(pb.robot_radius_m), dp, dv, dr, 0.0, ND)
+                float(rb.max_accel_mps2), discs, 0.0, ND)
         self.shield_counts[code] += 1
         return np.array([u, w])
 

@@ -19,9 +19,9 @@ as it is.  A diff-drive robot gets ``(v, omega)`` from
 3. **Admissibility** (Fox et al.'s rule, against the static map).  A speed
    is taken only when the disc swept along this tick's arc *and then along a
    straight stop of* ``v^2 / (2 a)`` *metres on the final heading* stays
-   ``radius`` (plus :data:`~pathfuse.geometry.MARGIN_FRAC` of a cell) clear
-   of every occupied square and the map's edge
-   (:func:`~pathfuse.sweep.arc_static_distance`, exact).  Otherwise the
+   the :class:`~pathfuse.costmap.Costmap`'s ``clear_m`` (the radius plus
+   :data:`~pathfuse.geometry.MARGIN_FRAC` of a cell) clear of every occupied
+   square and the map's edge (:func:`~pathfuse.costmap.arc_distance`, exact).  Otherwise the
    speed is lowered in 8 even steps towards the lowest speed of the window;
    if none passes, the same with the yaw rates of the window nearest the
    desired one (the last one, 0, either extreme).  If nothing passes, the
@@ -38,13 +38,14 @@ disc), and the moving discs are left to the controller that chose ``u``.
 Examples
 --------
 >>> import numpy as np
->>> occ = np.zeros((4, 4), dtype=np.bool_)
->>> v, w = unicycle_command(occ, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.1,
-...                         0.0, 1.0, 2.0, 2.0, 4.0, 0.2)
+>>> from pathfuse.costmap import make_costmap
+>>> cm = make_costmap(np.zeros((4, 4), dtype=np.bool_), 0.2, clear_m=0.2)
+>>> v, w = unicycle_command(cm, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.1,
+...                         0.0, 1.0, 2.0, 2.0, 4.0, 0.0)
 >>> round(v, 6), round(w, 6)     # straight ahead, from rest: the acceleration window
 (0.2, 0.0)
->>> v, w = unicycle_command(occ, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.1,
-...                         0.0, 1.0, 2.0, 2.0, 4.0, 0.2)
+>>> v, w = unicycle_command(cm, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.1,
+...                         0.0, 1.0, 2.0, 2.0, 4.0, 0.0)
 >>> round(v, 6), round(w, 6)     # 90 degrees to the left: turn on the spot
 (0.0, 0.4)
 """
@@ -57,8 +58,15 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from pathfuse.geometry import MARGIN_FRAC
-from pathfuse.sweep import arc_static_distance, segment_static_distance, unicycle_pose
+from pathfuse.costmap import (
+    Costmap,
+    arc_distance,
+    costmap_for,
+    make_costmap,
+    point_distance,
+    segment_distance,
+)
+from pathfuse.sweep import unicycle_pose
 
 __all__ = ["unicycle_command", "admissible", "wrap_angle", "to_unicycle", "warmup_drive"]
 
@@ -70,28 +78,29 @@ def wrap_angle(a: float) -> float:
 
 
 @njit(cache=True)
-def admissible(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
-               th: float, v: float, w: float, dt: float, brake_m: float, clear: float) -> bool:
+def admissible(cm: Costmap, x: float, y: float, th: float, v: float, w: float, dt: float,
+               brake_m: float, clear: float) -> bool:
     """Whether the arc of ``(v, w)`` over ``dt`` and a straight stop of ``brake_m`` on the
     final heading keep the disc ``clear`` from every occupied square and the map's edge."""
-    d = arc_static_distance(occ, ox, oy, res, x, y, th, v, w, dt, clear, clear)
+    d = arc_distance(cm, x, y, th, v, w, dt, clear, clear)
     if d < clear:
         return False
     if brake_m > 0.0:
         bx, by, bth = unicycle_pose(x, y, th, v, w, dt)
         ex = bx + brake_m * math.cos(bth)
         ey = by + brake_m * math.sin(bth)
-        if segment_static_distance(occ, ox, oy, res, bx, by, ex, ey, clear) < clear:
+        if segment_distance(cm, bx, by, ex, ey, clear) < clear:
             return False
     return True
 
 
 @njit(cache=True)
-def unicycle_command(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
-                     th: float, v0: float, w0: float, ux: float, uy: float, dt: float,
-                     vmin: float, vmax: float, amax: float, wmax: float, alpha: float,
-                     clear: float, margin: float = 0.0) -> tuple[float, float]:
-    """``(v, omega)`` for the desired velocity ``(ux, uy)`` (see the module docstring)."""
+def unicycle_command(cm: Costmap, x: float, y: float, th: float, v0: float, w0: float,
+                     ux: float, uy: float, dt: float, vmin: float, vmax: float, amax: float,
+                     wmax: float, alpha: float, margin: float = 0.0) -> tuple[float, float]:
+    """``(v, omega)`` for the desired velocity ``(ux, uy)`` (see the module docstring;
+    ``cm.clear_m`` is the clearance kept, ``margin`` the safety margin beyond it)."""
+    clear = cm.clear_m
     s = math.sqrt(ux * ux + uy * uy)
     v_des = 0.0
     w_des = 0.0
@@ -111,7 +120,7 @@ def unicycle_command(occ: np.ndarray, ox: float, oy: float, res: float, x: float
     vhi = min(vmax, v0 + amax * dt)
     v = min(max(v_des, vlo), vhi)
     # a robot that came closer than ``clear`` (braking too late) may keep what it has
-    d = segment_static_distance(occ, ox, oy, res, x, y, x, y, clear + margin + 1.0)
+    d = point_distance(cm, x, y, clear + margin + 1.0)
     if d < clear:
         clear = d * (1.0 - 1e-12)
     # with a safety margin: first keep it (or what is left of it), then only the radius
@@ -120,15 +129,14 @@ def unicycle_command(occ: np.ndarray, ox: float, oy: float, res: float, x: float
         hi = max(clear, clear + min(margin, max(d - clear, 0.0)) * (1.0 - 1e-9))
     for pas in range(2 if hi > clear else 1):
         cl = hi if pas == 0 else clear
-        vk, wj, ok = _first_admissible(occ, ox, oy, res, x, y, th, v, vlo, w, w0, wlo, whi,
-                                       dt, amax, cl)
+        vk, wj, ok = _first_admissible(cm, x, y, th, v, vlo, w, w0, wlo, whi, dt, amax, cl)
         if ok:
             return vk, wj
     return vlo, w
 
 
 @njit(cache=True)
-def _first_admissible(occ, ox, oy, res, x, y, th, v, vlo, w, w0, wlo, whi, dt, amax, clear):
+def _first_admissible(cm, x, y, th, v, vlo, w, w0, wlo, whi, dt, amax, clear):
     # the desired yaw rate first; if no speed is admissible with it, the yaw rates of the
     # window nearest to it (keep turning, go straight, turn hard either way)
     for j in range(5):
@@ -147,7 +155,7 @@ def _first_admissible(occ, ox, oy, res, x, y, th, v, vlo, w, w0, wlo, whi, dt, a
             brake = 0.0
             if vk > 0.0 and math.isfinite(amax):
                 brake = vk * vk / (2.0 * amax)
-            if admissible(occ, ox, oy, res, x, y, th, vk, wj, dt, brake, clear):
+            if admissible(cm, x, y, th, vk, wj, dt, brake, clear):
                 return vk, wj, True
     return vlo, w, False
 
@@ -155,25 +163,21 @@ def _first_admissible(occ, ox, oy, res, x, y, th, v, vlo, w, w0, wlo, whi, dt, a
 def to_unicycle(problem: Any, robot: Any, dt: float, obs: Any, u: Any) -> np.ndarray:
     """The diff-drive command for the desired velocity ``u`` of a controller, from the
     observation's pose and last command (:func:`unicycle_command`)."""
-    g = problem.grid
-    ox, oy = g.origin
+    cm = costmap_for(problem.grid, float(problem.robot_radius_m))
     cmd = obs.command
     v, w = unicycle_command(
-        g.occupied, float(ox), float(oy), float(g.resolution), float(obs.position[0]),
+        cm, float(obs.position[0]),
         float(obs.position[1]), float(obs.heading), float(cmd[0]), float(cmd[1]),
         float(u[0]), float(u[1]), float(dt), float(robot.min_speed_mps),
         float(robot.max_speed_mps), float(robot.max_accel_mps2),
         float(robot.max_yaw_rate_radps), float(robot.max_yaw_accel_radps2),
-        float(problem.robot_radius_m) + MARGIN_FRAC * float(g.resolution),
         float(problem.clearance_m))
     return np.array([v, w])
 
 
 def warmup_drive() -> None:
-    """Compile (or load from numba's cache) the conversion, for writeable and read-only
-    maps."""
-    for ro in (False, True):
-        occ = np.zeros((3, 3), dtype=np.bool_)
-        occ.setflags(write=not ro)
-        unicycle_command(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 0.0, 0.0, 0.0, 1.0, 0.5, 0.1, 0.0, 1.0,
-                         2.0, 2.0, 4.0, 0.2)
+    """Compile (or load from numba's cache) the conversion (a
+    :class:`~pathfuse.costmap.Costmap`'s map is always read-only)."""
+    cm = make_costmap(np.zeros((3, 3), dtype=np.bool_), 0.2)
+    unicycle_command(cm, 1.5, 1.5, 0.0, 0.0, 0.0, 1.0, 0.5, 0.1, 0.0, 1.0,
+                     2.0, 2.0, 4.0, 0.0)

@@ -32,10 +32,11 @@ robot's ``heading``, or facing the goal).
 Collisions (checked over the whole tick, not at its end points)
 ---------------------------------------------------------------
 * Static: the robot disc swept along its segment overlaps an occupied cell
-  or leaves the map - exactly, with
-  :func:`~pathfuse.sweep.segment_static_distance` (closed-form
+  or leaves the map - exactly, with the checks of the map's
+  :class:`~pathfuse.costmap.Costmap` (built once per map and radius):
+  :func:`~pathfuse.costmap.segment_distance` (closed-form
   segment-to-square distances; no sampling, so no step size is too large).
-  Along an arc: :func:`~pathfuse.sweep.arc_static_distance` (chords with a
+  Along an arc: :func:`~pathfuse.costmap.arc_distance` (chords with a
   provable deviation bound, refined to 1e-9 m where it decides).
 * Moving discs: both centres move linearly over the tick, so their distance
   is minimised in closed form
@@ -92,16 +93,11 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse.costmap import arc_distance, costmap_for, segment_distance
 from pathfuse.geometry import point_segment_distance
 from pathfuse.result import PathfuseError, QueryError, Status
 from pathfuse.shield import clip_holonomic, clip_unicycle
-from pathfuse.sweep import (
-    arc_disc_gaps,
-    arc_static_distance,
-    disc_sweep_gaps,
-    segment_static_distance,
-    unicycle_pose,
-)
+from pathfuse.sweep import arc_disc_gaps, disc_sweep_gaps, unicycle_pose
 from pathfuse.validate import short as _shown
 from pathfuse.world.obstacles import obstacle_trajectories
 from pathfuse.world.scenario import Scenario, load_scenario
@@ -186,14 +182,12 @@ class World:
         self.scenario: Scenario = load_scenario(scenario)
         sc = self.scenario
         g = sc.grid
-        self._occ = g.occupied
-        self._ox = float(g.origin[0])
-        self._oy = float(g.origin[1])
-        self._res = float(g.resolution)
         self.dt = float(sc.dt)
         self.n_steps = sc.n_steps
         self.robot = sc.robot
         self.radius = float(sc.robot.radius_m)
+        # the static map and the robot's disc: the collision test's costmap
+        self.costmap = costmap_for(g, self.radius)
         self.max_speed = float(sc.robot.max_speed_mps)
         self.sensing_radius = float(sc.robot.sensing_radius_m)
         self.diff_drive = self.robot.is_diff_drive
@@ -236,9 +230,8 @@ class World:
         Negative means overlap; capped at :data:`STATIC_CLEARANCE_CAP_M`.
         """
         b = a if b is None else b
-        d = segment_static_distance(self._occ, self._ox, self._oy, self._res, float(a[0]),
-                                    float(a[1]), float(b[0]), float(b[1]),
-                                    self.radius + STATIC_CLEARANCE_CAP_M)
+        d = segment_distance(self.costmap, float(a[0]), float(a[1]), float(b[0]), float(b[1]),
+                             self.radius + STATIC_CLEARANCE_CAP_M)
         return float(d) - self.radius
 
     def _sense(self) -> SensedObstacles:
@@ -345,9 +338,9 @@ class World:
             p1 = p0 + cmd * self.dt
             th1 = math.atan2(cmd[1], cmd[0]) if (cmd[0] or cmd[1]) else th0
         if arc:
-            d = arc_static_distance(self._occ, self._ox, self._oy, self._res, float(p0[0]),
-                                    float(p0[1]), th0, float(cmd[0]), float(cmd[1]), self.dt,
-                                    self.radius, self.radius + STATIC_CLEARANCE_CAP_M)
+            d = arc_distance(self.costmap, float(p0[0]), float(p0[1]), th0, float(cmd[0]),
+                             float(cmd[1]), self.dt, self.radius,
+                             self.radius + STATIC_CLEARANCE_CAP_M)
             static_gap = float(d) - self.radius
         else:
             static_gap = self.static_gap(p0, p1)

@@ -83,16 +83,17 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from pathfuse.costmap import costmap_for
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
 from pathfuse.planners.controllers.dwa_kernel import (
+    DwaTick,
     dwa_choose,
+    dwa_tick,
     pack_dwa,
     relaxed,
     route_tangent,
-    set_keep_reference,
-    set_route,
 )
 from pathfuse.planners.controllers.replan import replan_around_discs
 from pathfuse.planners.controllers.social import PassingSides, disc_ids
@@ -191,14 +192,15 @@ class DWAController(Controller):
             if p.replan_period_s > 0 else 0
         self.ticks = 0
         self.replans = 0
-        ox, oy = g.origin
+        # the map, the radius and the clearance kept (self.clear_m) in one object
+        self.costmap = costmap_for(g, float(problem.robot_radius_m))
         self.f = pack_dwa(
             self.tick_s, rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2,
-            rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2, problem.robot_radius_m,
-            self.clear_m, max(problem.clearance_m, rb.clearance_m), p.horizon_s, p.sim_step_s,
+            rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2,
+            max(problem.clearance_m, rb.clearance_m), p.horizon_s, p.sim_step_s,
             p.v_samples, p.w_samples, p.path_weight, p.goal_weight, p.heading_weight,
             p.speed_weight, p.obstacle_weight, p.moving_weight, p.obstacle_range_m,
-            p.lookahead_m, p.inflation_decay_m, not rb.is_diff_drive, ox, oy, g.resolution,
+            p.lookahead_m, p.inflation_decay_m, not rb.is_diff_drive,
             p.passive_safety,
             w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
             keep_m=p.keep_m, w_social=p.social_weight if p.social else 0.0,
@@ -249,13 +251,12 @@ class DWAController(Controller):
                                       g.occupied, float(g.origin[0]), float(g.origin[1]),
                                       float(g.resolution), self.clear_m))
         f = self._f_relaxed if self.ticks <= self._relaxed_until else self.f
-        set_keep_reference(g.occupied, f, self.pts, self.cum, self.k)
         n = drad.shape[0]
         ids = np.arange(n) if ids is None else ids
         chosen = np.zeros((n, 2))
         route = route_tangent(self.pts, self.k, th)
-        set_route(f, route)
-        a0, a1, count, _ = dwa_choose(self.problem.grid.occupied, f, x, y, th, c0, c1,
+        tick = dwa_tick(self.costmap, f, self.pts, self.cum, self.k, route)
+        a0, a1, count, _ = dwa_choose(self.costmap, f, tick, x, y, th, c0, c1,
                                       self.pts, self.cum, self.k, dpos, dvel, drad,
                                       self.sides.sides(ids), chosen)
         if n:
@@ -375,8 +376,9 @@ class DWAController(Controller):
             for ro in (False, True):
                 q = np.ones((1, 2))
                 q.setflags(write=not ro)
-                dwa_choose(g.occupied, c.f, 0.5, 0.5, 0.0, 0.0, 0.0, c.pts, c.cum, 0, q, q,
-                           np.ones(1), np.zeros(1), np.zeros((1, 2)))
+                dwa_choose(c.costmap, c.f, DwaTick(math.inf, 0.0, 0.0), 0.5, 0.5, 0.0, 0.0,
+                           0.0, c.pts, c.cum, 0, q, q, np.ones(1), np.zeros(1),
+                           np.zeros((1, 2)))
         route_tangent(c.pts, 0, 0.0)
         _WARM[0] = True
 

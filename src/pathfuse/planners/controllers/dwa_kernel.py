@@ -2,91 +2,137 @@
 
 :func:`dwa_choose` samples the commands reachable within one tick, rolls each
 out over the horizon, scores it and returns the best; :func:`dwa_progress`
-moves the robot's progress index along the global path.  Settings travel in
-one float array (indices ``D_*``), filled by :func:`pack_dwa`.
+moves the robot's progress index along the global path.  The static map and
+the robot's disc come as one :class:`~pathfuse.costmap.Costmap`, the
+settings as one :class:`DwaSettings` (read by name, filled by
+:func:`pack_dwa`), and what changes every tick (the keep critic's reference,
+the route direction) as one :class:`DwaTick` (:func:`dwa_tick`).
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
+from pathfuse.costmap import Discs, segment_distance
 from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.controllers.social import dwell_shortfall
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
-from pathfuse.sweep import (
-    arc_deviation_bound,
-    disc_sweep_gaps,
-    segment_static_distance,
-    unicycle_pose,
-)
+from pathfuse.sweep import arc_deviation_bound, disc_sweep_gaps, unicycle_pose
 
-__all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "relaxed", "set_keep_reference",
-           "route_tangent", "set_route", "N_D"]
+__all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "relaxed", "dwa_tick",
+           "keep_reference", "route_tangent", "DwaSettings", "DwaTick"]
 
-(D_DT, D_VMIN, D_VMAX, D_AMAX, D_WMAX, D_ALPHA, D_RADIUS, D_CLEAR, D_MARGIN, D_HORIZON,
- D_SIMDT, D_NV, D_NW, D_WPATH, D_WGOAL, D_WHEAD, D_WSPEED, D_WOBS, D_WDYN, D_RANGE,
- D_LOOK, D_DECAY, D_HOLO, D_OX, D_OY, D_RES, D_PASSIVE, D_WALIGN, D_NEAR, D_WKEEP, D_KEEP,
- D_GREF, D_WSOC, D_PERSONAL, D_WSIDE, D_TX, D_TY, D_DWELL, D_WDWELL) = range(39)
-N_D = 39
 SOFT = 0.3
 KEEP_FLOOR = 0.02
 """The keep critic's shortfall is relative to the path's gap, but to at least this (m)."""
 PASSIVE_COST = 20.0
 
 
-def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
-             n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
-             decay, holonomic, ox, oy, res, passive=True, w_align=0.0, near_s=0.0,
-             w_keep=0.0, keep_m=0.3, w_social=0.0, personal_m=0.5, w_side=0.0, dwell_s=0.0,
-             w_dwell=0.0):
-    """The settings array of :func:`dwa_choose`.
+class DwaSettings(NamedTuple):
+    """The settings of :func:`dwa_choose`, read by name (one argument), from
+    :func:`pack_dwa`.  The map, the robot's radius and the clearance it keeps are the
+    :class:`~pathfuse.costmap.Costmap`'s."""
+
+    dt_s: float
+    min_speed_mps: float
+    max_speed_mps: float
+    max_accel_mps2: float
+    max_yaw_rate_radps: float
+    max_yaw_accel_radps2: float
+    margin_m: float
+    horizon_s: float
+    sim_step_s: float
+    v_samples: int
+    w_samples: int
+    path_weight: float
+    goal_weight: float
+    heading_weight: float
+    speed_weight: float
+    obstacle_weight: float
+    moving_weight: float
+    obstacle_range_m: float
+    lookahead_m: float
+    inflation_decay_m: float
+    holonomic: bool
+    passive: bool
+    path_align_weight: float
+    keep_horizon_s: float
+    keep_weight: float
+    keep_m: float
+    social_weight: float
+    personal_m: float
+    side_weight: float
+    dwell_s: float
+    dwell_weight: float
+
+
+class DwaTick(NamedTuple):
+    """What :func:`dwa_choose` reads that changes every tick (:func:`dwa_tick`)."""
+
+    keep_ref_m: float
+    """The keep critic's reference gap (``inf`` when the critic is off)."""
+    route_x: float
+    route_y: float
+    """The route direction against which passing sides are told (``(0, 0)``: the path's)."""
+
+
+def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, margin, horizon, sim_dt, n_v, n_w, w_path,
+             w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead, decay,
+             holonomic, passive=True, w_align=0.0, near_s=0.0, w_keep=0.0, keep_m=0.3,
+             w_social=0.0, personal_m=0.5, w_side=0.0, dwell_s=0.0, w_dwell=0.0):
+    """The settings of :func:`dwa_choose`.
 
     With a safety margin (``margin > 0``) the passing-side critic is off: holding a side
     pressed the robot against a wall in ``examples/scenarios/corridor_oncoming.yaml``
-    (``tests/test_clearance.py``), which a margin forbids."""
+    (``tests/test_clearance.py``), which a margin forbids.
+
+    Examples
+    --------
+    >>> s = pack_dwa(0.1, 0.0, 1.0, 2.0, 2.0, 4.0, 0.0, 2.0, 0.1, 7, 9, 1.0, 1.0, 0.5,
+    ...              0.2, 1.0, 1.0, 1.0, 1.0, 0.1, False)
+    >>> s.max_speed_mps, s.v_samples, s.holonomic, relaxed(s).obstacle_weight
+    (1.0, 7, False, 0.0)
+    """
     if margin > 0.0:
         w_side = 0.0
-    f = np.zeros(N_D)
-    vals = (dt, vmin, vmax, amax, wmax, alpha, radius, clear, margin, horizon, sim_dt, n_v,
-            n_w, w_path, w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead,
-            decay, 1.0 if holonomic else 0.0, ox, oy, res, 1.0 if passive else 0.0,
-            w_align, near_s, w_keep, keep_m, np.inf, w_social, personal_m, w_side, 0.0, 0.0,
-            dwell_s, w_dwell)
-    for i, v in enumerate(vals):
-        f[i] = float(v)
-    return f
+    return DwaSettings(
+        float(dt), float(vmin), float(vmax), float(amax), float(wmax), float(alpha),
+        float(margin), float(horizon), float(sim_dt), int(float(n_v)), int(float(n_w)),
+        float(w_path), float(w_goal), float(w_head), float(w_speed), float(w_obs),
+        float(w_dyn), float(obstacle_range), float(lookahead), float(decay), bool(holonomic),
+        bool(passive), float(w_align), float(near_s), float(w_keep), float(keep_m),
+        float(w_social), float(personal_m), float(w_side), float(dwell_s), float(w_dwell))
 
 
-def relaxed(f):
-    """A copy of the settings ``f`` without the obstacle and keep critics and the margin (the
+def relaxed(s):
+    """The settings ``s`` without the obstacle and keep critics and the margin (the
     recovery behaviour that clears them, :mod:`pathfuse.planners.recovery`)."""
-    out = f.copy()
-    out[D_WOBS] = 0.0
-    out[D_MARGIN] = 0.0
-    out[D_WKEEP] = 0.0
-    return out
+    return s._replace(obstacle_weight=0.0, margin_m=0.0, keep_weight=0.0)
 
 
-def set_keep_reference(occ, f, pts, cum, k):
-    """Store in ``f`` the keep critic's reference for this tick: the gap the path ``pts``
-    keeps from its point ``k`` over what the robot travels in ``keep_horizon_s`` at full
-    speed (at least 0.5 m).  Nothing when the critic is off."""
-    if f[D_WKEEP] > 0.0:
-        f[D_GREF] = path_gap(occ, f, pts, cum, k, max(f[D_VMAX] * f[D_NEAR], 0.5))
+def keep_reference(cm, s, pts, cum, k):
+    """The keep critic's reference for this tick: the gap the path ``pts`` keeps from its
+    point ``k`` over what the robot travels in ``keep_horizon_s`` at full speed (at least
+    0.5 m); ``inf`` when the critic is off."""
+    if s.keep_weight > 0.0:
+        return float(path_gap(cm, s, pts, cum, k, max(s.max_speed_mps * s.keep_horizon_s,
+                                                      0.5)))
+    return math.inf
+
+
+def dwa_tick(cm, s, pts, cum, k, route):
+    """The :class:`DwaTick` of this tick: the keep reference along ``pts`` from ``k``
+    (:func:`keep_reference`) and the route direction ``route``."""
+    return DwaTick(keep_reference(cm, s, pts, cum, k), float(route[0]), float(route[1]))
 
 
 @njit(cache=True, inline="always")
 def _wrap(a):
     return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
-def set_route(f, tangent):
-    """Store in ``f`` the route direction against which passing sides are told."""
-    f[D_TX] = float(tangent[0])
-    f[D_TY] = float(tangent[1])
 
 
 @njit(cache=True)
@@ -164,18 +210,18 @@ def _path_distance(pts, cum, k, jg, x, y):
 
 
 @njit(cache=True)
-def path_gap(occ, f, pts, cum, k, length):
+def path_gap(cm, s, pts, cum, k, length):
     """The least gap (distance less the robot's radius) of the path from ``pts[k]`` over
     ``length`` metres, up to ``keep_m`` (the reference of the keep critic)."""
     m = pts.shape[0]
-    radius = f[D_RADIUS]
-    cap = radius + f[D_KEEP] + 1e-9
-    slack = MARGIN_FRAC * f[D_RES]
+    radius = cm.radius_m
+    cap = radius + s.keep_m + 1e-9
+    slack = MARGIN_FRAC * cm.res_m
     best = cap
     j = k
     while j + 1 < m and cum[j] - cum[k] <= length:
-        d = segment_static_distance(occ, f[D_OX], f[D_OY], f[D_RES], pts[j, 0], pts[j, 1],
-                                    pts[j + 1, 0], pts[j + 1, 1], cap, slack)
+        d = segment_distance(cm, pts[j, 0], pts[j, 1], pts[j + 1, 0], pts[j + 1, 1], cap,
+                             slack)
         if d < best:
             best = d
         j += 1
@@ -183,28 +229,25 @@ def path_gap(occ, f, pts, cum, k, length):
 
 
 @njit(cache=True)
-def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx, ty, dside,
-             sides):
+def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
+             ty, dside, sides):
     """Score one sample: ``out = [cost, admissible, first_tick_clear]``; ``sides[j] = (side,
     least predicted gap)`` of the sample against sensed disc ``j`` (the social critics,
     :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction)."""
-    ox = f[D_OX]
-    oy = f[D_OY]
-    res = f[D_RES]
-    dt = f[D_DT]
-    clear = f[D_CLEAR]
-    radius = f[D_RADIUS]
+    res = cm.res_m
+    dt = f.dt_s
+    radius = cm.radius_m
     # the edge rule of segment_is_clear: pathfuse's margin is kept from squares, not the edge
     slack = MARGIN_FRAC * res
-    horizon = f[D_HORIZON]
-    h = f[D_SIMDT]
-    rng = f[D_RANGE]
+    horizon = f.horizon_s
+    h = f.sim_step_s
+    rng = f.obstacle_range_m
     n = max(1, int(math.ceil(horizon / h - 1e-9)))
     e = arc_deviation_bound(v, w, h)
     cap = clear + rng + e
     dmin = cap
     speed = abs(v)
-    amax = f[D_AMAX]
+    amax = f.max_accel_mps2
     brake = 0.0
     if math.isfinite(amax) and amax > 0.0:
         brake = speed * speed / (2.0 * amax)
@@ -223,7 +266,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
     pb = np.empty(2)
     reach = np.empty(n_disc)
     stop_s = dt + (speed / amax if math.isfinite(amax) and amax > 0.0 else 0.0)
-    if f[D_PASSIVE] != 1.0:
+    if not f.passive:
         stop_s = 0.0
     for j in range(n_disc):
         reach[j] = math.hypot(dvel[j, 0], dvel[j, 1]) * stop_s
@@ -232,11 +275,11 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
     for j in range(n_disc):
         sides[j, 0] = 0.0
         sides[j, 1] = np.inf
-    near = f[D_NEAR]
+    near = f.keep_horizon_s
     dnear = cap
     # the path-align critic holds the robot to the global path: not while a moving disc is
     # sensed (the path may be what it crosses; the global path is replanned around it)
-    walign = f[D_WALIGN] if n_disc == 0 else 0.0
+    walign = f.path_align_weight if n_disc == 0 else 0.0
     align = 0.0
     n_align = 0
     tc = np.inf
@@ -247,15 +290,14 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
     for i in range(1, n + 1):
         t = min(i * h, horizon)
         bx, by, bth = unicycle_pose(x, y, th, v, w, t)
-        d = segment_static_distance(occ, ox, oy, res, ax, ay, bx, by, cap, slack) - e
+        d = segment_distance(cm, ax, ay, bx, by, cap, slack) - e
         if t <= dt + 1e-12:
             # the tick itself: the arc (lower bound) and the chord (the path offline) clear
             if d < clear:
                 first_ok = False
                 ok = False
                 break
-            if e > 0.0 and segment_static_distance(occ, ox, oy, res, ax, ay, bx, by,
-                                                   clear, slack) < clear:
+            if e > 0.0 and segment_distance(cm, ax, ay, bx, by, clear, slack) < clear:
                 first_ok = False
                 ok = False
                 break
@@ -329,8 +371,8 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
             dyn = SOFT * math.exp(-max(gmin, 0.0) / 0.2)
     soc = 0.0
     side_cost = 0.0
-    personal = f[D_PERSONAL]
-    if n_disc > 0 and (f[D_WSOC] > 0.0 or f[D_WSIDE] > 0.0):
+    personal = f.personal_m
+    if n_disc > 0 and (f.social_weight > 0.0 or f.side_weight > 0.0):
         # ours (pathfuse.planners.controllers.social): personal space over the predicted
         # gaps, and the committed passing sides
         for j in range(n_disc):
@@ -343,10 +385,10 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
                     and gj < personal + 1.0:
                 side_cost = 1.0
     dwc = 0.0
-    if n_disc > 0 and f[D_DWELL] > 0.0 and f[D_WDWELL] > 0.0:
+    if n_disc > 0 and f.dwell_s > 0.0 and f.dwell_weight > 0.0:
         # ours (the dwell critic): the robot may have to stand where the rollout ends
-        dwc = f[D_WDWELL] * dwell_shortfall(ex, ey, tend, dpos, dvel, drad, radius,
-                                            f[D_DWELL], personal)
+        dwc = f.dwell_weight * dwell_shortfall(ex, ey, tend, dpos, dvel, drad, radius,
+                                               f.dwell_s, personal)
     # the end point against the path near the progress index: its distance to the path and
     # how much path is left beyond its projection
     m = pts.shape[0]
@@ -356,7 +398,7 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
         s_end = cum[m - 1]
     left = cum[m - 1] - s_end
     # the carrot: lookahead_m of path beyond the projection
-    sc = min(s_end + f[D_LOOK], cum[m - 1])
+    sc = min(s_end + f.lookahead_m, cum[m - 1])
     j = k
     while j + 1 < m - 1 and cum[j + 1] < sc:
         j += 1
@@ -366,28 +408,29 @@ def _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
     gx = pts[j, 0] + u * (pts[min(j + 1, m - 1), 0] - pts[j, 0])
     gy = pts[j, 1] + u * (pts[min(j + 1, m - 1), 1] - pts[j, 1])
     gd = math.hypot(gx - ex, gy - ey)
-    if f[D_HOLO] == 1.0:
+    if f.holonomic:
         hd = math.atan2(gy - y, gx - x)
         he = abs(_wrap(hd - th)) / math.pi if speed > 0.0 else 0.5
     else:
         he = abs(_wrap(math.atan2(gy - ey, gx - ex) - eth)) / math.pi if gd > 1e-9 else 0.0
     gap = dmin - radius
-    obs = math.exp(-max(gap, 0.0) / f[D_DECAY]) if dmin < cap else 0.0
-    margin = f[D_MARGIN]
+    obs = math.exp(-max(gap, 0.0) / f.inflation_decay_m) if dmin < cap else 0.0
+    margin = f.margin_m
     if margin > 0.0 and gap < margin:
         obs += 10.0 * (margin - gap) / margin
-    out[0] = (f[D_WPATH] * pd + f[D_WGOAL] * left + f[D_WHEAD] * he
-              + f[D_WSPEED] * (f[D_VMAX] - v) / f[D_VMAX] + f[D_WOBS] * obs + f[D_WDYN] * dyn
-              + f[D_WSOC] * soc + f[D_WSIDE] * side_cost + dwc)
+    out[0] = (f.path_weight * pd + f.goal_weight * left + f.heading_weight * he
+              + f.speed_weight * (f.max_speed_mps - v) / f.max_speed_mps
+              + f.obstacle_weight * obs + f.moving_weight * dyn
+              + f.social_weight * soc + f.side_weight * side_cost + dwc)
     if n_align > 0:
         out[0] += walign * align / n_align
-    wkeep = f[D_WKEEP] if n_disc == 0 else 0.0
+    wkeep = f.keep_weight if n_disc == 0 else 0.0
     if wkeep > 0.0:
         # ours: keep the gap the global path keeps ahead (up to keep_m): the shortfall of
         # the least gap over the first obstacle_horizon_s, squared, relative to keep_m; a
         # sample that keeps as much as the path pays nothing, so standing in front of a
         # narrowing the path goes through is not cheaper than going through
-        want = min(f[D_GREF], f[D_KEEP])
+        want = min(gref, f.keep_m)
         short = want - (dnear - radius)
         if short > 0.0 and want > 0.0:
             out[0] += wkeep * min((short / max(want, KEEP_FLOOR)) ** 2, 1.0)
@@ -405,13 +448,15 @@ def _passive_penalty(gap):
 
 
 @njit(cache=True)
-def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chosen):
+def dwa_choose(cm, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chosen):
     """The best command from the dynamic window.
 
     ``dside`` holds the committed passing side of each sensed disc (+1, -1, 0: none) and
     ``chosen`` receives the best sample's ``(side, predicted gap)`` against each
     (:mod:`pathfuse.planners.controllers.social`); the side is told against the route direction
-    ``f[D_TX], f[D_TY]`` (:func:`set_route`), or the path's at ``k`` when that is zero.
+    ``tick.route_x, tick.route_y`` (:func:`dwa_tick`), or the path's at ``k`` when that is
+    zero.  ``cm`` is the static map with the robot's radius and clearance, ``f`` the
+    :class:`DwaSettings`.
 
     ``(c0, c1)`` is the last command: ``(v, omega)`` for a diff-drive robot,
     ``(vx, vy)`` for a holonomic one.  Returns ``(a0, a1, admissible_count,
@@ -422,50 +467,50 @@ def dwa_choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, c
     clearance; a robot already deeper inside gets none passing); only when
     none passes, to ``clear``.
     """
-    margin = f[D_MARGIN]
+    margin = f.margin_m
+    clear = cm.clear_m
     if margin > 0.0:
-        clear = f[D_CLEAR]
-        d = segment_static_distance(occ, f[D_OX], f[D_OY], f[D_RES], x, y, x, y,
-                                    clear + margin, MARGIN_FRAC * f[D_RES])
+        d = segment_distance(cm, x, y, x, y, clear + margin, MARGIN_FRAC * cm.res_m)
         # keep the margin, or at least half of it where the robot still has that much
         hi = clear + min(margin, max(d - clear, 0.5 * margin)) * (1.0 - 1e-9)
         if hi > clear:
-            f2 = f.copy()
-            f2[D_CLEAR] = hi
-            a0, a1, count, best = _choose(occ, f2, x, y, th, c0, c1, pts, cum, k, dpos, dvel,
-                                          drad, dside, chosen)
+            a0, a1, count, best = _choose(cm, f, hi, tick, x, y, th, c0, c1, pts, cum, k,
+                                          dpos, dvel, drad, dside, chosen)
             if count > 0:
                 return a0, a1, count, best
-    return _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chosen)
+    return _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside,
+                   chosen)
 
 
 @njit(cache=True)
-def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chosen):
-    dt = f[D_DT]
-    vmax = f[D_VMAX]
-    amax = f[D_AMAX]
-    nv = int(f[D_NV])
-    nw = int(f[D_NW])
-    jg = _local_goal(pts, cum, k, f[D_VMAX] * f[D_HORIZON] + f[D_LOOK] + 1.0)
+def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside,
+            chosen):
+    dt = f.dt_s
+    vmax = f.max_speed_mps
+    amax = f.max_accel_mps2
+    nv = f.v_samples
+    nw = f.w_samples
+    jg = _local_goal(pts, cum, k, f.max_speed_mps * f.horizon_s + f.lookahead_m + 1.0)
     out = np.zeros(3)
     best = np.inf
     b0 = 0.0
     b1 = 0.0
     count = 0
-    n_disc = drad.shape[0] if f[D_PASSIVE] == 1.0 else 0
+    n_disc = drad.shape[0] if f.passive else 0
     dspeed = np.empty(n_disc)
     for j in range(n_disc):
         dspeed[j] = math.hypot(dvel[j, 0], dvel[j, 1])
+    discs = Discs(dpos, dvel, dspeed, drad)
     nd = drad.shape[0]
     sides = np.zeros((nd, 2))
     for j in range(nd):
         chosen[j, 0] = 0.0
         chosen[j, 1] = np.inf
-    tx = f[D_TX]
-    ty = f[D_TY]
+    tx = tick.route_x
+    ty = tick.route_y
     if tx == 0.0 and ty == 0.0:
         tx, ty = route_tangent(pts, k, th)
-    if f[D_HOLO] == 1.0:
+    if f.holonomic:
         # velocity vectors: speeds x directions (3 w_samples of them, every 8 degrees by
         # default), within |u - u0| <= a dt
         lim = amax * dt
@@ -489,11 +534,11 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chos
                             uy *= vmax / sn * (1.0 - 1e-12)
                 sp = math.hypot(ux, uy)
                 hd = math.atan2(uy, ux) if sp > 0.0 else th
-                _rollout(occ, f, x, y, hd, sp, 0.0, pts, cum, k, jg, dpos, dvel, drad, out, tx,
-                         ty, dside, sides)
+                _rollout(cm, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg,
+                         dpos, dvel, drad, out, tx, ty, dside, sides)
                 if out[1] == 1.0 and n_disc > 0:
                     out[0] += _passive_penalty(holonomic_stop_disc_gap(
-                        x, y, ux, uy, dt, amax, f[D_RADIUS], dpos, dspeed, drad))
+                        x, y, ux, uy, dt, amax, cm.radius_m, discs))
                 if out[1] == 1.0:
                     count += 1
                     if out[0] < best:
@@ -507,10 +552,10 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chos
                 sc = max(0.0, 1.0 - lim / max(math.hypot(c0, c1), 1e-300))
             return c0 * sc, c1 * sc, 0, np.inf
         return b0, b1, count, best
-    vlo = max(f[D_VMIN], c0 - amax * dt)
+    vlo = max(f.min_speed_mps, c0 - amax * dt)
     vhi = min(vmax, c0 + amax * dt)
-    wlo = max(-f[D_WMAX], c1 - f[D_ALPHA] * dt)
-    whi = min(f[D_WMAX], c1 + f[D_ALPHA] * dt)
+    wlo = max(-f.max_yaw_rate_radps, c1 - f.max_yaw_accel_radps2 * dt)
+    whi = min(f.max_yaw_rate_radps, c1 + f.max_yaw_accel_radps2 * dt)
     for i in range(nv):
         # exactly on the window's edges (the world clips anything beyond them)
         v = vhi if i == nv - 1 else min(max(vlo + (vhi - vlo) * (i / (nv - 1)), vlo), vhi)
@@ -520,11 +565,11 @@ def _choose(occ, f, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chos
                                                 whi)
             else:
                 w = min(max(0.0, wlo), whi)  # always try going straight
-            _rollout(occ, f, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx, ty,
-                     dside, sides)
+            _rollout(cm, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, dpos, dvel,
+                     drad, out, tx, ty, dside, sides)
             if out[1] == 1.0 and n_disc > 0:
                 out[0] += _passive_penalty(unicycle_stop_disc_gap(
-                    x, y, th, v, w, dt, amax, f[D_ALPHA], f[D_RADIUS], dpos, dspeed, drad))
+                    x, y, th, v, w, dt, amax, f.max_yaw_accel_radps2, cm.radius_m, discs))
             if out[1] == 1.0:
                 count += 1
                 if out[0] < best:

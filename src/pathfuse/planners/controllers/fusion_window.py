@@ -63,17 +63,16 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse.costmap import costmap_for
 from pathfuse.field.pathing import polyline_cumlen
-from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.base import sensed_discs
 from pathfuse.planners.controllers.dwa_kernel import (
     dwa_choose,
     dwa_progress,
+    dwa_tick,
     pack_dwa,
     relaxed,
     route_tangent,
-    set_keep_reference,
-    set_route,
 )
 from pathfuse.planners.controllers.social import PassingSides, disc_ids
 
@@ -128,15 +127,15 @@ class ForceWindow:
         self.problem = problem
         self.horizon_s = float(p.horizon_s)
         self.vmax = float(rb.max_speed_mps)
-        ox, oy = g.origin
+        # the map, the radius and the clearance kept (radius + MARGIN_FRAC of a cell)
+        self.costmap = costmap_for(g, float(problem.robot_radius_m))
         self.f = pack_dwa(
             dt, rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2, rb.max_yaw_rate_radps,
-            rb.max_yaw_accel_radps2, problem.robot_radius_m,
-            problem.robot_radius_m + MARGIN_FRAC * g.resolution,
+            rb.max_yaw_accel_radps2,
             max(problem.clearance_m, rb.clearance_m), p.horizon_s, p.sim_step_s, p.v_samples,
             p.w_samples, p.path_weight, p.goal_weight, p.heading_weight, p.speed_weight,
             p.obstacle_weight, p.moving_weight, p.obstacle_range_m, p.lookahead_m,
-            p.inflation_decay_m, False, ox, oy, g.resolution, PASSIVE_WINDOW,
+            p.inflation_decay_m, False, PASSIVE_WINDOW,
             w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
             keep_m=p.keep_m, w_social=sp.social_weight if sp.social else 0.0,
             personal_m=sp.personal_m, w_side=sp.side_weight if sp.social else 0.0,
@@ -187,7 +186,7 @@ class ForceWindow:
     def relax(self, seconds: float) -> None:
         """Recovery (ours, as Nav2's clear-costmap): no obstacle critic and no margin for
         ``seconds``, following a new A* path (the shield keeps the robot clear)."""
-        self.relaxed_until = self.ticks + int(round(seconds / float(self.f[0])))
+        self.relaxed_until = self.ticks + int(round(seconds / self.f.dt_s))
         self.relax_replan = True
 
     def _replan(self, x: float, y: float) -> None:
@@ -267,15 +266,13 @@ class ForceWindow:
         f = self.f_relaxed if self.ticks <= self.relaxed_until else self.f
         # the keep critic's reference: the gap the A* path keeps ahead (the local path is
         # the field's streamline, which may graze)
-        set_keep_reference(self.problem.grid.occupied, f, pts, cum,
-                           min(max(int(k), 0), pts.shape[0] - 1))
         n = drad.shape[0]
         ids = disc_ids(obs, n)
         chosen = np.zeros((n, 2))
         # passing sides are told against the A* route (the local path bends around discs)
         route = route_tangent(pts, min(max(int(k), 0), pts.shape[0] - 1), th)
-        set_route(f, route)
-        a0, a1, _, _ = dwa_choose(self.problem.grid.occupied, f, x, y,
+        tick = dwa_tick(self.costmap, f, pts, cum, min(max(int(k), 0), pts.shape[0] - 1), route)
+        a0, a1, _, _ = dwa_choose(self.costmap, f, tick, x, y,
                                   float(obs.heading), float(cmd[0]), float(cmd[1]), path, pcum,
                                   kk, dpos, dvel, drad, self.sides.sides(ids), chosen)
         if n:
@@ -316,7 +313,7 @@ class ForceWindow:
 
     def _rotate(self, err: float) -> np.ndarray:
         rb = self.problem.robot
-        dt = float(self.f[0])
+        dt = self.f.dt_s
         rate = min(abs(err) / dt, rb.max_yaw_rate_radps)
         if math.isfinite(rb.max_yaw_accel_radps2):
             rate = min(rate, math.sqrt(2.0 * rb.max_yaw_accel_radps2 * abs(err)))

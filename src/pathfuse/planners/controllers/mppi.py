@@ -80,13 +80,13 @@ from __future__ import annotations
 
 import math
 import time
-import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
+from pathfuse.costmap import NO_DISCS, clearance_lattice, costmap_for
 from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.grid import GridMap
@@ -198,40 +198,12 @@ class MPPIParams(PersonalSpaceParams, GlobalAStarParams):
                                          "ticks is a stall")
 
 
-_FIELDS: weakref.WeakKeyDictionary[GridMap, dict[float, tuple[np.ndarray, float]]] = \
-    weakref.WeakKeyDictionary()
-_MAX_FIELD_CELLS = 4_000_000
-
-
 def clearance_field(grid: GridMap, cell_m: float) -> tuple[np.ndarray, float]:
     """A clearance lower bound on a lattice of the map's cells split ``s x s`` (``s`` up to 8,
-    so that a lattice cell is about ``cell_m``): the distance from each lattice cell centre to
-    the nearest occupied square, less half a lattice cell's diagonal (that is
-    :attr:`GridMap.distance_field` less a cell's half-diagonal when ``s = 1``).  Returns
+    so that a lattice cell is about ``cell_m``): :func:`pathfuse.costmap.clearance_lattice`,
+    the distance layer of the :class:`~pathfuse.costmap.Costmap`.  Returns
     ``(field, lattice cell side)``; cached per map."""
-    res = float(grid.resolution)
-    h, w = grid.shape
-    s = max(1, min(8, int(math.ceil(res / cell_m - 1e-9))))
-    while s > 1 and h * w * s * s > _MAX_FIELD_CELLS:
-        s -= 1
-    per = _FIELDS.setdefault(grid, {})
-    hit = per.get(float(s))
-    if hit is not None:
-        return hit
-    r = res / s
-    if s == 1:
-        df = grid.distance_field
-    elif not grid.occupied.any():
-        df = np.full((h * s, w * s), np.inf)
-    else:
-        from scipy import ndimage
-
-        fine = np.repeat(np.repeat(grid.occupied, s, axis=0), s, axis=1)
-        df = ndimage.distance_transform_edt(~fine) * r
-    out = np.ascontiguousarray(df - r * math.sqrt(0.5), dtype=np.float64)
-    out.setflags(write=False)
-    per[float(s)] = (out, r)
-    return out, r
+    return clearance_lattice(grid, cell_m)
 
 
 def _offline_robot(problem: Problem) -> RobotModel:
@@ -267,7 +239,10 @@ class MPPIController(Controller):
         self.tick_s = float(dt) if dt is not None else float(p.dt_s)
         g = problem.grid
         self.clear_m = problem.robot_radius_m + MARGIN_FRAC * g.resolution
-        self.field, fres = clearance_field(g, p.clearance_cell_m)
+        # the map, the radius and the clearance lattice (about clearance_cell_m) in one object
+        self.costmap = costmap_for(g, float(problem.robot_radius_m),
+                                   field_cell_m=p.clearance_cell_m)
+        self.field = self.costmap.field
         self._set_path(np.asarray(plan.waypoints, dtype=np.float64).reshape(-1, 2))
         self.replan_every = int(round(p.replan_period_s / self.tick_s)) \
             if p.replan_period_s > 0 else 0
@@ -277,12 +252,10 @@ class MPPIController(Controller):
         vmax = rb.max_speed_mps
         if self.online and max_speed is not None and self.holonomic:
             vmax = min(vmax, float(max_speed))
-        ox, oy = (float(v) for v in g.origin)
         self.f = pack_mppi(
             self.tick_s, p.model_dt_s, rb.min_speed_mps, vmax, rb.max_accel_mps2,
             rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2, self.holonomic,
-            problem.robot_radius_m, max(problem.clearance_m, rb.clearance_m), ox, oy,
-            ox + g.width * g.resolution, oy + g.height * g.resolution, fres, p.temperature,
+            max(problem.clearance_m, rb.clearance_m), p.temperature,
             p.collision_cost, p.obstacle_weight, p.inflation_radius_m, p.cost_scaling_factor,
             p.path_align_weight, p.path_follow_weight, p.goal_weight, p.goal_distance_m,
             p.path_angle_weight, p.lookahead_m, p.disc_collision_cost,
@@ -290,7 +263,7 @@ class MPPIController(Controller):
             p.prefer_forward_weight, p.vx_std_mps,
             p.vy_std_mps if self.holonomic else p.wz_std_radps, self.seg_max,
             float(problem.goal[0]), float(problem.goal[1]), p.obstacle_peak_weight,
-            g.resolution, min(vmax, p.slow_guide_speed_mps), p.keep_better_guide,
+            min(vmax, p.slow_guide_speed_mps), p.keep_better_guide,
             w_social=p.social_weight if p.social else 0.0, personal_m=p.personal_m,
             dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight)
         self._baseline()
@@ -316,13 +289,11 @@ class MPPIController(Controller):
         self.seg_max = float(np.diff(self.cum).max()) if self.pts.shape[0] > 1 else 0.0
         self.k = 0
         if hasattr(self, "f"):
-            from pathfuse.planners.controllers.mppi_kernel import M_SEGMAX
-
-            self.f[M_SEGMAX] = self.seg_max
+            self.f = self.f._replace(seg_max_m=self.seg_max)
             self._baseline()
 
     def _baseline(self) -> None:
-        self.pexp = path_inflation(self.field, self.f, self.pts,
+        self.pexp = path_inflation(self.costmap, self.f, self.pts,
                                    bool(self.params.relative_inflation))
 
     def _replan(self, x: float, y: float) -> None:
@@ -352,7 +323,7 @@ class MPPIController(Controller):
         self.ticks += 1
         self.rng.standard_normal(out=self.noise)
         goal_mode = float(self.cum[-1] - self.cum[self.k]) <= self.params.goal_distance_m
-        a0, a1, _, free = mppi_optimise(g.occupied, self.field, self.f, x, y, th, c0, c1,
+        a0, a1, _, free = mppi_optimise(self.costmap, self.f, x, y, th, c0, c1,
                                         self.nominal, self.noise, self.ctrl, self.weights,
                                         self.pts, self.cum, self.pexp, self.k, goal_mode, dpos,
                                         dvel, drad)
@@ -377,21 +348,16 @@ class MPPIController(Controller):
         from pathfuse.shield import ND, NV, NW, shield_holonomic, shield_unicycle
 
         rb = self.robot
-        g = self.problem.grid
-        ox, oy = float(g.origin[0]), float(g.origin[1])
-        z2, z1 = _NO_DISCS[0], _NO_DISCS[2]
-        r = float(self.problem.robot_radius_m)
+        cm = self.costmap
         if self.holonomic:
-            u, w, code = shield_holonomic(g.occupied, ox, oy, float(g.resolution), x, y, c0,
-                                          c1, a0, a1, self.tick_s, rb.max_speed_mps,
-                                          rb.max_accel_mps2, self.clear_m, r, z2, z1, z1, 0.0,
+            u, w, code = shield_holonomic(cm, x, y, c0, c1, a0, a1, self.tick_s,
+                                          rb.max_speed_mps, rb.max_accel_mps2, NO_DISCS, 0.0,
                                           ND)
         else:
-            u, w, code = shield_unicycle(g.occupied, ox, oy, float(g.resolution), x, y, th, c0,
-                                         c1, a0, a1, self.tick_s, rb.min_speed_mps,
-                                         rb.max_speed_mps, rb.max_accel_mps2,
-                                         rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2,
-                                         self.clear_m, r, z2, z1, z1, 0.0, NV, NW)
+            u, w, code = shield_unicycle(cm, x, y, th, c0, c1, a0, a1, self.tick_s,
+                                         rb.min_speed_mps, rb.max_speed_mps,
+                                         rb.max_accel_mps2, rb.max_yaw_rate_radps,
+                                         rb.max_yaw_accel_radps2, NO_DISCS, 0.0, NV, NW)
         self.offline_shield[code] += 1
         return float(u), float(w)
 
@@ -511,7 +477,7 @@ class MPPIController(Controller):
             for ro in (False, True):
                 q = np.ones((1, 2))
                 q.setflags(write=not ro)
-                mppi_optimise(g.occupied, c.field, c.f, 0.5, 0.5, 0.0, 0.0, 0.0, c.nominal,
+                mppi_optimise(c.costmap, c.f, 0.5, 0.5, 0.0, 0.0, 0.0, c.nominal,
                               c.noise, c.ctrl, c.weights, c.pts, c.cum, c.pexp, 0, False,
                               q, q, np.ones(1))
         _WARM[0] = True

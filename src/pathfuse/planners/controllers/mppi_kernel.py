@@ -7,60 +7,113 @@ sequence and the nominal plus the given Gaussian noise, each clipped step by
 step to the robot's limits and acceleration windows), rolls each out (exact
 unicycle arcs or straight moves), scores it with the critics and replaces the
 nominal sequence with the softmax-weighted mean of the batch (or with the
-fast guide when that scores better, unless switched off).  Settings travel in
-one float array (indices ``M_*``) filled by :func:`pack_mppi`.
+fast guide when that scores better, unless switched off).  The static map,
+the robot's radius and the clearance lattice come as one
+:class:`~pathfuse.costmap.Costmap`, the settings as one :class:`MppiSettings`
+(read by name, filled by :func:`pack_mppi`).
 
 The static clearance of a point is read from a lower-bound field (metres from
 each cell centre of a fine lattice to the nearest occupied square, less half
-a lattice cell's diagonal; see :func:`pathfuse.planners.controllers.mppi.clearance_field`):
+a lattice cell's diagonal; the Costmap's ``field``, :func:`pathfuse.costmap.field_distance`):
 ``field[c] - |p - c|`` is a lower bound of the distance from ``p`` to the
 occupied squares (the distance is 1-Lipschitz).  Between two rollout points
 ``a`` and ``b`` at least ``c`` away from every obstacle, the whole segment is
 at least ``sqrt(c^2 - |ab|^2 / 4)`` away; an arc leaves its chord by at most
 ``|v omega| h^2 / 8``.  Where these bounds say a step comes closer than the
-radius, the chord's exact distance (:func:`pathfuse.sweep.segment_static_distance`)
+radius, the chord's exact distance (:func:`pathfuse.costmap.segment_distance`)
 less that bound decides.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
+from pathfuse.costmap import field_distance, segment_distance
 from pathfuse.planners.controllers.social import dwell_shortfall
-from pathfuse.sweep import segment_static_distance, unicycle_pose
+from pathfuse.sweep import unicycle_pose
 
-__all__ = ["mppi_optimise", "pack_mppi", "path_inflation", "N_M", "static_gap"]
+__all__ = ["mppi_optimise", "pack_mppi", "path_inflation", "MppiSettings"]
 
-(M_DT, M_MDT, M_VMIN, M_VMAX, M_AMAX, M_WMAX, M_ALPHA, M_HOLO, M_RADIUS, M_MARGIN,
- M_OX, M_OY, M_XMAX, M_YMAX, M_FRES, M_TEMP, M_WCOLL, M_WOBS, M_INFL_R, M_INFL_K,
- M_WALIGN, M_WPROG, M_WGOAL, M_GOALD, M_WHEAD, M_LOOK, M_WDCOLL, M_WDPROX, M_DDECAY,
- M_WSMOOTH, M_WFWD, M_STD0, M_STD1, M_SEGMAX, M_GX, M_GY, M_PEAK, M_RES, M_SLOW,
- M_KEEP, M_WSOC, M_PERSONAL, M_DWELL, M_WDWELL) = range(44)
-N_M = 44
 MARGIN_COST = 1.0
 """Inside the robot's safety margin the obstacle cost grows by this much per margin width."""
 N_FIXED = 4
 """Samples that are not noise: the nominal sequence, the two guides, the braking sequence."""
 
 
-def pack_mppi(dt, model_dt, vmin, vmax, amax, wmax, alpha, holonomic, radius, margin, ox, oy,
-              xmax, ymax, field_res, temperature, w_coll, w_obs, infl_radius, infl_k, w_align,
-              w_prog, w_goal, goal_dist, w_head, lookahead, w_dcoll, w_dprox, disc_decay,
-              w_smooth, w_fwd, std0, std1, seg_max, gx, gy, w_peak, res, slow, keep_guide,
-              w_social=0.0, personal_m=0.5, dwell_s=0.0, w_dwell=0.0):
-    """The settings array of :func:`mppi_optimise`."""
-    vals = (dt, model_dt, vmin, vmax, amax, wmax, alpha, 1.0 if holonomic else 0.0, radius,
-            margin, ox, oy, xmax, ymax, field_res, temperature, w_coll, w_obs, infl_radius,
-            infl_k, w_align, w_prog, w_goal, goal_dist, w_head, lookahead, w_dcoll, w_dprox,
-            disc_decay, w_smooth, w_fwd, std0, std1, seg_max, gx, gy, w_peak, res, slow,
-            1.0 if keep_guide else 0.0, w_social, personal_m, dwell_s, w_dwell)
-    f = np.zeros(N_M)
-    for i, v in enumerate(vals):
-        f[i] = float(v)
-    return f
+class MppiSettings(NamedTuple):
+    """The settings of :func:`mppi_optimise`, read by name (one argument), from
+    :func:`pack_mppi`.  The map, its frame, the robot's radius and the clearance lattice are
+    the :class:`~pathfuse.costmap.Costmap`'s."""
+
+    dt_s: float
+    model_dt_s: float
+    min_speed_mps: float
+    max_speed_mps: float
+    max_accel_mps2: float
+    max_yaw_rate_radps: float
+    max_yaw_accel_radps2: float
+    holonomic: bool
+    margin_m: float
+    temperature: float
+    collision_cost: float
+    obstacle_weight: float
+    inflation_radius_m: float
+    cost_scaling_factor: float
+    path_align_weight: float
+    path_follow_weight: float
+    goal_weight: float
+    goal_distance_m: float
+    path_angle_weight: float
+    lookahead_m: float
+    disc_collision_cost: float
+    disc_proximity_weight: float
+    disc_decay_m: float
+    smoothness_weight: float
+    prefer_forward_weight: float
+    std0: float
+    """The noise of the first control (m/s)."""
+    std1: float
+    """The noise of the second control (m/s holonomic, rad/s diff-drive)."""
+    seg_max_m: float
+    """The longest segment of the path followed (rewritten with the path)."""
+    goal_x_m: float
+    goal_y_m: float
+    obstacle_peak_weight: float
+    slow_guide_speed_mps: float
+    keep_better_guide: bool
+    social_weight: float
+    personal_m: float
+    dwell_s: float
+    dwell_weight: float
+
+
+def pack_mppi(dt, model_dt, vmin, vmax, amax, wmax, alpha, holonomic, margin, temperature,
+              w_coll, w_obs, infl_radius, infl_k, w_align, w_prog, w_goal, goal_dist, w_head,
+              lookahead, w_dcoll, w_dprox, disc_decay, w_smooth, w_fwd, std0, std1, seg_max,
+              gx, gy, w_peak, slow, keep_guide, w_social=0.0, personal_m=0.5, dwell_s=0.0,
+              w_dwell=0.0):
+    """The settings of :func:`mppi_optimise`.
+
+    Examples
+    --------
+    >>> s = pack_mppi(0.1, 0.1, 0.0, 1.0, 2.0, 2.0, 4.0, False, 0.0, 0.3, 1e4, 1.0, 0.55,
+    ...               10.0, 1.0, 1.0, 5.0, 1.4, 2.0, 1.0, 1e4, 1.0, 0.3, 0.1, 5.0, 0.2, 0.4,
+    ...               0.5, 9.0, 9.0, 1.0, 0.3, True)
+    >>> s.max_speed_mps, s.seg_max_m, s.holonomic, s._replace(seg_max_m=2.0).seg_max_m
+    (1.0, 0.5, False, 2.0)
+    """
+    return MppiSettings(
+        float(dt), float(model_dt), float(vmin), float(vmax), float(amax), float(wmax),
+        float(alpha), bool(holonomic), float(margin), float(temperature), float(w_coll),
+        float(w_obs), float(infl_radius), float(infl_k), float(w_align), float(w_prog),
+        float(w_goal), float(goal_dist), float(w_head), float(lookahead), float(w_dcoll),
+        float(w_dprox), float(disc_decay), float(w_smooth), float(w_fwd), float(std0),
+        float(std1), float(seg_max), float(gx), float(gy), float(w_peak), float(slow),
+        bool(keep_guide), float(w_social), float(personal_m), float(dwell_s), float(w_dwell))
 
 
 @njit(cache=True, inline="always")
@@ -69,52 +122,36 @@ def _wrap(a):
 
 
 @njit(cache=True)
-def static_gap(field, f, x, y):
-    """Lower bounds of the distances from ``(x, y)`` to the occupied squares and (exact) to
-    the map's outside: ``(squares, edge)``, the edge one negative outside the map (and the
-    squares' one taken from the nearest lattice cell)."""
-    ox = f[M_OX]
-    oy = f[M_OY]
-    de = min(x - ox, f[M_XMAX] - x, y - oy, f[M_YMAX] - y)
-    r = f[M_FRES]
-    h, w = field.shape
-    c = min(max(int(math.floor((x - ox) / r)), 0), w - 1)
-    q = min(max(int(math.floor((y - oy) / r)), 0), h - 1)
-    d = field[q, c] - math.hypot(x - (ox + (c + 0.5) * r), y - (oy + (q + 0.5) * r))
-    return d, de
-
-
-@njit(cache=True)
-def path_inflation(field, f, pts, relative):
+def path_inflation(cm, f, pts, relative):
     """The inflation cost ``exp(-factor x gap)`` at each path point (the baseline the rollouts'
     obstacle critic is measured against); zeros when ``relative`` is false."""
     out = np.zeros(pts.shape[0])
     if not relative:
         return out
     for i in range(pts.shape[0]):
-        gap = static_gap(field, f, pts[i, 0], pts[i, 1])[0] - f[M_RADIUS]
-        if gap < f[M_INFL_R]:
-            out[i] = math.exp(-f[M_INFL_K] * gap)
+        gap = field_distance(cm, pts[i, 0], pts[i, 1])[0] - cm.radius_m
+        if gap < f.inflation_radius_m:
+            out[i] = math.exp(-f.cost_scaling_factor * gap)
     return out
 
 
 @njit(cache=True, inline="always")
 def _clip_uni(pv, pw, v, w, h, f):
-    a = f[M_AMAX] * h
-    b = f[M_ALPHA] * h
-    v = min(max(v, max(f[M_VMIN], pv - a)), min(f[M_VMAX], pv + a))
-    w = min(max(w, max(-f[M_WMAX], pw - b)), min(f[M_WMAX], pw + b))
+    a = f.max_accel_mps2 * h
+    b = f.max_yaw_accel_radps2 * h
+    v = min(max(v, max(f.min_speed_mps, pv - a)), min(f.max_speed_mps, pv + a))
+    w = min(max(w, max(-f.max_yaw_rate_radps, pw - b)), min(f.max_yaw_rate_radps, pw + b))
     return v, w
 
 
 @njit(cache=True, inline="always")
 def _clip_holo(px, py, ux, uy, h, f):
-    vmax = f[M_VMAX]
+    vmax = f.max_speed_mps
     s = math.hypot(ux, uy)
     if s > vmax:
         ux *= vmax / s * (1.0 - 1e-12)
         uy *= vmax / s * (1.0 - 1e-12)
-    lim = f[M_AMAX] * h
+    lim = f.max_accel_mps2 * h
     if math.isfinite(lim):
         dx = ux - px
         dy = uy - py
@@ -131,9 +168,9 @@ def _clip_sequence(seq, f, c0, c1):
     (the first step's window is the tick's, the others the model step's)."""
     p0 = c0
     p1 = c1
-    holo = f[M_HOLO] == 1.0
+    holo = f.holonomic
     for t in range(seq.shape[0]):
-        h = f[M_DT] if t == 0 else f[M_MDT]
+        h = f.dt_s if t == 0 else f.model_dt_s
         if holo:
             a, b = _clip_holo(p0, p1, seq[t, 0], seq[t, 1], h, f)
         else:
@@ -200,27 +237,27 @@ def _point_at(pts, cum, s):
 
 
 @njit(cache=True)
-def _guide(seq, f, field, x, y, th, c0, c1, pts, cum, k0, look, vslow):
+def _guide(seq, f, cm, x, y, th, c0, c1, pts, cum, k0, look, vslow):
     """A pure-pursuit sequence (ours): towards a carrot ``look`` of path ahead, turning as
     fast as the heading can still stop, slowing to stop at the goal.  With ``vslow > 0`` its
     speed is regulated by the clearance, as Nav2's regulated pure pursuit does: the limit
     times ``gap / inflation_radius_m``, at least ``vslow``."""
-    vmax = f[M_VMAX]
+    vmax = f.max_speed_mps
     px = x
     py = y
     pth = th
     p0 = c0
     p1 = c1
     j = k0
-    holo = f[M_HOLO] == 1.0
-    amax = f[M_AMAX]
-    alpha = f[M_ALPHA]
-    gx = f[M_GX]
-    gy = f[M_GY]
-    fwd = vmax * max(f[M_DT], f[M_MDT]) + 2.0 * f[M_SEGMAX]
+    holo = f.holonomic
+    amax = f.max_accel_mps2
+    alpha = f.max_yaw_accel_radps2
+    gx = f.goal_x_m
+    gy = f.goal_y_m
+    fwd = vmax * max(f.dt_s, f.model_dt_s) + 2.0 * f.seg_max_m
     for t in range(seq.shape[0]):
-        h = f[M_DT] if t == 0 else f[M_MDT]
-        j, _, tt = _track(px, py, pts, cum, j, k0, fwd, 2.0 * f[M_SEGMAX])
+        h = f.dt_s if t == 0 else f.model_dt_s
+        j, _, tt = _track(px, py, pts, cum, j, k0, fwd, 2.0 * f.seg_max_m)
         s = cum[j] + tt * (cum[min(j + 1, cum.shape[0] - 1)] - cum[j])
         cx, cy = _point_at(pts, cum, s + look)
         dg = math.hypot(gx - px, gy - py)
@@ -229,8 +266,8 @@ def _guide(seq, f, field, x, y, th, c0, c1, pts, cum, k0, look, vslow):
             # the speed from which braking in steps of a h stops at the goal
             vcap = min(vmax, amax * (math.sqrt(0.25 * h * h + 2.0 * dg / amax) - 0.5 * h))
         if vslow > 0.0:
-            gap = static_gap(field, f, px, py)[0] - f[M_RADIUS]
-            vcap = min(vcap, max(vslow, vmax * gap / f[M_INFL_R]))
+            gap = field_distance(cm, px, py)[0] - cm.radius_m
+            vcap = min(vcap, max(vslow, vmax * gap / f.inflation_radius_m))
         behind = (cx == gx and cy == gy and
                   (gx - px) * math.cos(pth) + (gy - py) * math.sin(pth) <= 0.0)
         if holo:
@@ -269,9 +306,9 @@ def _brake(seq, f, c0, c1):
     """Braking as hard as the limits allow, the yaw rate unwinding likewise."""
     p0 = c0
     p1 = c1
-    holo = f[M_HOLO] == 1.0
+    holo = f.holonomic
     for t in range(seq.shape[0]):
-        h = f[M_DT] if t == 0 else f[M_MDT]
+        h = f.dt_s if t == 0 else f.model_dt_s
         if holo:
             a, b = _clip_holo(p0, p1, 0.0, 0.0, h, f)
         else:
@@ -283,25 +320,25 @@ def _brake(seq, f, c0, c1):
 
 
 @njit(cache=True)
-def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_mode, dpos,
+def _score(seq, cm, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_mode, dpos,
            dvel, drad):
     """The cost of one control sequence (the critics, summed with their weights)."""
     n = seq.shape[0]
-    holo = f[M_HOLO] == 1.0
-    radius = f[M_RADIUS]
-    margin = f[M_MARGIN]
-    infl_r = f[M_INFL_R]
-    infl_k = f[M_INFL_K]
-    segmax = f[M_SEGMAX]
-    std0 = f[M_STD0]
-    std1 = f[M_STD1]
-    gx = f[M_GX]
-    gy = f[M_GY]
+    holo = f.holonomic
+    radius = cm.radius_m
+    margin = f.margin_m
+    infl_r = f.inflation_radius_m
+    infl_k = f.cost_scaling_factor
+    segmax = f.seg_max_m
+    std0 = f.std0
+    std1 = f.std1
+    gx = f.goal_x_m
+    gy = f.goal_y_m
     nd = drad.shape[0]
     px = x
     py = y
     pth = th
-    ca, ea = static_gap(field, f, x, y)
+    ca, ea = field_distance(cm, x, y)
     j = k0
     cost = 0.0
     obs = 0.0
@@ -321,7 +358,7 @@ def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_m
     # ours (pathfuse.planners.controllers.social): the least predicted gap to each disc
     dgap = np.full(nd, np.inf)
     for t in range(n):
-        h = f[M_DT] if t == 0 else f[M_MDT]
+        h = f.dt_s if t == 0 else f.model_dt_s
         a = seq[t, 0]
         b = seq[t, 1]
         d0 = (a - p0) / std0
@@ -339,18 +376,18 @@ def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_m
             dev = abs(a * b) * h * h / 8.0
             if a < 0.0:
                 back += -a * h
-        cb, eb = static_gap(field, f, nx, ny)
+        cb, eb = field_distance(cm, nx, ny)
         c = min(ca, cb)
         half = 0.5 * math.hypot(nx - px, ny - py)
         seg = math.sqrt(c * c - half * half) if c > half else 0.0
         # the distance to the map's outside is concave along a segment: its least at an end
         if seg - dev < thr or min(ea, eb) - dev < thr:
             # too close by the lower bounds: the chord's exact distance decides
-            d = segment_static_distance(occ, f[M_OX], f[M_OY], f[M_RES], px, py, nx, ny,
+            d = segment_distance(cm, px, py, nx, ny,
                                         thr + dev + 1e-6)
             if d - dev < thr:
                 # a collision with the static map: the earlier, the costlier; it ends here
-                cost += f[M_WCOLL] * (2.0 * n - t) / n
+                cost += f.collision_cost * (2.0 * n - t) / n
                 hit = True
                 break
         j, d, tt = _track(nx, ny, pts, cum, j, k0, 2.0 * half + 2.0 * segmax, 2.0 * segmax)
@@ -385,7 +422,7 @@ def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_m
                     tc = t
                 depth = max(depth, min(-g / (radius + drad[i]), 1.0))
             else:
-                prox += math.exp(-g / f[M_DDECAY])
+                prox += math.exp(-g / f.disc_decay_m)
         align += d
         if goal_mode:
             goal += math.hypot(nx - gx, ny - gy)
@@ -397,41 +434,43 @@ def _score(seq, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_m
         tnow += h
     m = pts.shape[0]
     s_end = cum[j] + tt * (cum[min(j + 1, m - 1)] - cum[j])
-    cost += f[M_WPROG] * (cum[m - 1] - s_end)
-    cost += f[M_WOBS] * obs / n + f[M_PEAK] * peak + f[M_WSMOOTH] * smooth / n \
-        + f[M_WFWD] * back
+    cost += f.path_follow_weight * (cum[m - 1] - s_end)
+    cost += f.obstacle_weight * obs / n + f.obstacle_peak_weight * peak \
+        + f.smoothness_weight * smooth / n + f.prefer_forward_weight * back
     if tc >= 0:
-        cost += f[M_WDCOLL] * (1.0 + depth + (n - tc) / n)
-    cost += f[M_WDPROX] * prox / n
-    if f[M_WSOC] > 0.0:
+        cost += f.disc_collision_cost * (1.0 + depth + (n - tc) / n)
+    cost += f.disc_proximity_weight * prox / n
+    if f.social_weight > 0.0:
         # personal space: the worst disc's shortfall, relative, squared
         soc = 0.0
         for i in range(nd):
-            if dgap[i] < f[M_PERSONAL]:
-                sh = (f[M_PERSONAL] - max(dgap[i], 0.0)) / f[M_PERSONAL]
+            if dgap[i] < f.personal_m:
+                sh = (f.personal_m - max(dgap[i], 0.0)) / f.personal_m
                 soc = max(soc, sh * sh)
-        cost += f[M_WSOC] * soc
-    if f[M_DWELL] > 0.0 and f[M_WDWELL] > 0.0 and not hit:
+        cost += f.social_weight * soc
+    if f.dwell_s > 0.0 and f.dwell_weight > 0.0 and not hit:
         # ours (the dwell critic): the robot may have to stand where the rollout ends
-        cost += f[M_WDWELL] * dwell_shortfall(px, py, tnow, dpos, dvel, drad, radius,
-                                              f[M_DWELL], f[M_PERSONAL])
+        cost += f.dwell_weight * dwell_shortfall(px, py, tnow, dpos, dvel, drad, radius,
+                                                 f.dwell_s, f.personal_m)
     if goal_mode:
-        cost += f[M_WGOAL] * goal / n
+        cost += f.goal_weight * goal / n
     else:
-        cost += f[M_WALIGN] * align / n
+        cost += f.path_align_weight * align / n
         if not holo:
-            cx, cy = _point_at(pts, cum, s_end + f[M_LOOK])
+            cx, cy = _point_at(pts, cum, s_end + f.lookahead_m)
             if math.hypot(cx - px, cy - py) > 1e-9:
-                cost += f[M_WHEAD] * abs(_wrap(math.atan2(cy - py, cx - px) - pth)) / math.pi
+                cost += f.path_angle_weight * abs(
+                    _wrap(math.atan2(cy - py, cx - px) - pth)) / math.pi
     return cost, hit
 
 
 @njit(cache=True)
-def mppi_optimise(occ, field, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, pts, cum,
+def mppi_optimise(cm, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, pts, cum,
                   pexp, k0, goal_mode, dpos, dvel, drad):
     """One MPPI update from the pose ``(x, y, th)`` and the last command ``(c0, c1)``.
 
-    ``occ`` is the map's occupancy, ``field`` its clearance lower bound.
+    ``cm`` is the static map with the robot's radius and the clearance lattice, ``f`` the
+    :class:`MppiSettings`.
     ``nominal`` (T, 2) is the previous optimal sequence shifted by the caller;
     on return it holds the new one.  ``noise`` (K, T, 2) holds standard normal
     draws (the first ``N_FIXED`` rows unused), ``ctrl`` (K, T, 2) and ``costs``
@@ -445,19 +484,20 @@ def mppi_optimise(occ, field, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, 
     nk = ctrl.shape[0]
     n = ctrl.shape[1]
     # the clearance a rollout must keep: the radius, or what a robot already closer has
-    radius = f[M_RADIUS]
-    here = segment_static_distance(occ, f[M_OX], f[M_OY], f[M_RES], x, y, x, y, radius)
+    radius = cm.radius_m
+    here = segment_distance(cm, x, y, x, y, radius)
     thr = min(radius, here * (1.0 - 1e-9))
-    std0 = f[M_STD0]
-    std1 = f[M_STD1]
+    std0 = f.std0
+    std1 = f.std1
     for t in range(n):
         ctrl[0, t, 0] = nominal[t, 0]
         ctrl[0, t, 1] = nominal[t, 1]
     _clip_sequence(ctrl[0], f, c0, c1)
-    _guide(ctrl[1], f, field, x, y, th, c0, c1, pts, cum, k0, f[M_LOOK], 0.0)
+    _guide(ctrl[1], f, cm, x, y, th, c0, c1, pts, cum, k0, f.lookahead_m, 0.0)
     # a regulated guide that slows near obstacles and keeps close to the path (it threads
     # narrow passages)
-    _guide(ctrl[2], f, field, x, y, th, c0, c1, pts, cum, k0, 0.5 * f[M_LOOK], f[M_SLOW])
+    _guide(ctrl[2], f, cm, x, y, th, c0, c1, pts, cum, k0, 0.5 * f.lookahead_m,
+           f.slow_guide_speed_mps)
     _brake(ctrl[3], f, c0, c1)
     for k in range(N_FIXED, nk):
         for t in range(n):
@@ -467,7 +507,7 @@ def mppi_optimise(occ, field, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, 
     best = np.inf
     free = 0
     for k in range(nk):
-        c, hit = _score(ctrl[k], occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0,
+        c, hit = _score(ctrl[k], cm, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0,
                         goal_mode, dpos, dvel, drad)
         costs[k] = c
         if c < best:
@@ -475,7 +515,7 @@ def mppi_optimise(occ, field, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, 
         if not hit:
             free += 1
     guide = costs[1]
-    lam = f[M_TEMP]
+    lam = f.temperature
     total = 0.0
     for k in range(nk):
         wk = math.exp(-(costs[k] - best) / lam)
@@ -493,9 +533,9 @@ def mppi_optimise(occ, field, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, 
     _clip_sequence(nominal, f, c0, c1)
     # the guide instead when it scores better than the mean (ours: on an open path the
     # noise's weighted mean is never exactly straight, the guide is)
-    mean, _ = _score(nominal, occ, field, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0,
+    mean, _ = _score(nominal, cm, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0,
                      goal_mode, dpos, dvel, drad)
-    if f[M_KEEP] == 1.0 and guide <= mean:
+    if f.keep_better_guide and guide <= mean:
         for t in range(n):
             nominal[t, 0] = ctrl[1, t, 0]
             nominal[t, 1] = ctrl[1, t, 1]

@@ -71,19 +71,18 @@ Examples
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit
 
-from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.costmap import Costmap, arc_distance, costmap_for, make_costmap, segment_distance
 from pathfuse.shield import unicycle_stop_clear
-from pathfuse.sweep import arc_static_distance, segment_static_distance
 
 __all__ = ["RegulatedPurePursuit", "rpp_step", "closest_progress", "point_at", "carrot_point",
            "pursuit_curvature", "lookahead_distance", "regulated_speed", "carrot_is_clear",
-           "pack_settings", "warmup_rpp", "MODE_PURSUIT", "MODE_ROTATE", "MODE_ARRIVED",
-           "SHRINKS"]
+           "pack_settings", "RppSettings", "warmup_rpp", "MODE_PURSUIT", "MODE_ROTATE",
+           "MODE_ARRIVED", "SHRINKS"]
 
 #: What :func:`rpp_step` did: followed the arc, turned on the spot, or stood at the goal.
 MODE_PURSUIT, MODE_ROTATE, MODE_ARRIVED = 0, 1, 2
@@ -97,36 +96,50 @@ CARROT_MARGIN_M = 0.002
 #: Headings tried (both ways, rad) when no way to any carrot is clear from the present one.
 _TURNS = (0.05, 0.1, 0.2, 0.35, 0.5, 0.8)
 
-# settings array layout (pack_settings)
-(S_LA_TIME, S_LA_MIN, S_LA_MAX, S_ROT, S_RMIN, S_VREG, S_PROX, S_APPROACH, S_VAPPROACH,
- S_SEARCH, S_CLEAR_CARROT, S_VMAX, S_AMAX, S_WMAX, S_ALPHA, S_DT, S_RADIUS, S_CLEAR) = range(18)
-N_SETTINGS = 18
+class RppSettings(NamedTuple):
+    """The follower's settings as :func:`rpp_step` reads them (one argument, by name), from
+    :func:`pack_settings`.  The map, the radius and the clearance kept are the
+    :class:`~pathfuse.costmap.Costmap`'s."""
+
+    lookahead_time_s: float
+    min_lookahead_m: float
+    max_lookahead_m: float
+    rotate_min_angle_rad: float
+    regulated_min_radius_m: float
+    regulated_min_speed_mps: float
+    proximity_distance_m: float
+    approach_distance_m: float
+    min_approach_speed_mps: float
+    pose_search_distance_m: float
+    clear_carrot: bool
+    max_speed_mps: float
+    max_accel_mps2: float
+    max_yaw_rate_radps: float
+    max_yaw_accel_radps2: float
+    dt_s: float
 
 
-def pack_settings(params: Any, robot: Any, dt: float, max_speed: float, radius: float,
-                  res: float) -> np.ndarray:
-    """The settings array of :func:`rpp_step` from the parameters (a
-    :class:`~pathfuse.planners.params.PursuitParams`) and the robot's limits."""
-    s = np.empty(N_SETTINGS)
-    s[S_LA_TIME] = params.lookahead_time_s
-    s[S_LA_MIN] = params.min_lookahead_m
-    s[S_LA_MAX] = params.max_lookahead_m
-    s[S_ROT] = params.rotate_to_heading_min_angle_rad
-    s[S_RMIN] = params.regulated_min_radius_m
-    s[S_VREG] = params.regulated_min_speed_mps
-    s[S_PROX] = params.proximity_distance_m
-    s[S_APPROACH] = params.approach_distance_m
-    s[S_VAPPROACH] = params.min_approach_speed_mps
-    s[S_SEARCH] = params.pose_search_distance_m
-    s[S_CLEAR_CARROT] = 1.0 if params.clear_carrot else 0.0
-    s[S_VMAX] = min(float(max_speed), float(robot.max_speed_mps))
-    s[S_AMAX] = robot.max_accel_mps2
-    s[S_WMAX] = robot.max_yaw_rate_radps
-    s[S_ALPHA] = robot.max_yaw_accel_radps2
-    s[S_DT] = dt
-    s[S_RADIUS] = radius
-    s[S_CLEAR] = radius + MARGIN_FRAC * res
-    return s
+def pack_settings(params: Any, robot: Any, dt: float, max_speed: float) -> RppSettings:
+    """The settings of :func:`rpp_step` from the parameters (a
+    :class:`~pathfuse.planners.params.PursuitParams`) and the robot's limits.
+
+    Examples
+    --------
+    >>> from pathfuse.planners.params import PursuitParams
+    >>> from pathfuse.robot import RobotModel
+    >>> s = pack_settings(PursuitParams(), RobotModel.diff_drive(radius_m=0.2), 0.1, 0.5)
+    >>> s.max_speed_mps, s.dt_s
+    (0.5, 0.1)
+    """
+    return RppSettings(
+        float(params.lookahead_time_s), float(params.min_lookahead_m),
+        float(params.max_lookahead_m), float(params.rotate_to_heading_min_angle_rad),
+        float(params.regulated_min_radius_m), float(params.regulated_min_speed_mps),
+        float(params.proximity_distance_m), float(params.approach_distance_m),
+        float(params.min_approach_speed_mps), float(params.pose_search_distance_m),
+        bool(params.clear_carrot), min(float(max_speed), float(robot.max_speed_mps)),
+        float(robot.max_accel_mps2), float(robot.max_yaw_rate_radps),
+        float(robot.max_yaw_accel_radps2), float(dt))
 
 
 @njit(cache=True)
@@ -245,8 +258,8 @@ def regulated_speed(vmax: float, kappa: float, gap: float, d_goal: float, amax: 
 
 
 @njit(cache=True)
-def carrot_is_clear(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
-                    th: float, xr: float, yr: float, rot: float, clear: float) -> bool:
+def carrot_is_clear(cm: Costmap, x: float, y: float, th: float, xr: float, yr: float,
+                    rot: float, clear: float) -> bool:
     """Whether the robot disc keeps ``clear`` along its way to the carrot ``(xr, yr)``
     (robot frame): the pursuit arc, or, beyond the bearing ``rot``, the straight line
     after turning on the spot."""
@@ -258,10 +271,10 @@ def carrot_is_clear(occ: np.ndarray, ox: float, oy: float, res: float, x: float,
         c, s = math.cos(th), math.sin(th)
         bx = x + c * xr - s * yr
         by = y + s * xr + c * yr
-        return segment_static_distance(occ, ox, oy, res, x, y, bx, by, clear) >= clear
+        return segment_distance(cm, x, y, bx, by, clear) >= clear
     kappa = 2.0 * yr / (dist * dist)
     length = 2.0 * bearing / kappa
-    return arc_static_distance(occ, ox, oy, res, x, y, th, 1.0, kappa, length, clear,
+    return arc_distance(cm, x, y, th, 1.0, kappa, length, clear,
                                clear) >= clear
 
 
@@ -272,40 +285,40 @@ def _in_frame(px: float, py: float, x: float, y: float, c: float,
 
 
 @njit(cache=True)
-def _off_the_wall(occ: np.ndarray, ox: float, oy: float, res: float, px: float, py: float,
-                  clear: float) -> tuple[float, float]:
+def _off_the_wall(cm: Costmap, px: float, py: float, clear: float) -> tuple[float, float]:
     """The carrot moved away from the nearest obstacle until it keeps ``clear`` plus
     :data:`CARROT_MARGIN_M` (a path that touches the robot's clearance, as pathfuse's
     shortest paths do, cannot be driven on exactly: the shield keeps a hair more)."""
     want = clear + CARROT_MARGIN_M
+    res = cm.res_m
     cap = want + res
-    d = segment_static_distance(occ, ox, oy, res, px, py, px, py, cap)
+    d = segment_distance(cm, px, py, px, py, cap)
     if d >= want:
         return px, py
     h = 0.25 * res
-    gx = (segment_static_distance(occ, ox, oy, res, px + h, py, px + h, py, cap)
-          - segment_static_distance(occ, ox, oy, res, px - h, py, px - h, py, cap))
-    gy = (segment_static_distance(occ, ox, oy, res, px, py + h, px, py + h, cap)
-          - segment_static_distance(occ, ox, oy, res, px, py - h, px, py - h, cap))
+    gx = (segment_distance(cm, px + h, py, px + h, py, cap)
+          - segment_distance(cm, px - h, py, px - h, py, cap))
+    gy = (segment_distance(cm, px, py + h, px, py + h, cap)
+          - segment_distance(cm, px, py - h, px, py - h, cap))
     n = math.hypot(gx, gy)
     if n <= 0.0:
         return px, py
     qx = px + gx / n * (want - d)
     qy = py + gy / n * (want - d)
-    if segment_static_distance(occ, ox, oy, res, qx, qy, qx, qy, cap) > d:
+    if segment_distance(cm, qx, qy, qx, qy, cap) > d:
         return qx, qy
     return px, py
 
 
 @njit(cache=True)
-def _clear_candidate(occ: np.ndarray, ox: float, oy: float, res: float, x: float, y: float,
-                     th: float, cand: np.ndarray, nc: int, rot: float, clear: float) -> int:
+def _clear_candidate(cm: Costmap, x: float, y: float, th: float, cand: np.ndarray, nc: int,
+                     rot: float, clear: float) -> int:
     """The first (farthest) carrot candidate whose way from heading ``th`` is clear
     (:func:`carrot_is_clear`), or -1."""
     c, sn = math.cos(th), math.sin(th)
     for k in range(nc):
         xr, yr = _in_frame(cand[k, 0], cand[k, 1], x, y, c, sn)
-        if carrot_is_clear(occ, ox, oy, res, x, y, th, xr, yr, rot, clear):
+        if carrot_is_clear(cm, x, y, th, xr, yr, rot, clear):
             return k
     return -1
 
@@ -321,51 +334,52 @@ def _turn_rate(e: float, dt: float, wmax: float, alpha: float) -> float:
 
 
 @njit(cache=True)
-def rpp_step(path: np.ndarray, cum: np.ndarray, occ: np.ndarray, ox: float, oy: float,
-             res: float, cfg: np.ndarray, x: float, y: float, th: float, v0: float, w0: float,
-             i0: int, s0: float) -> tuple[float, float, int, float, int, float, float]:
+def rpp_step(path: np.ndarray, cum: np.ndarray, cm: Costmap, cfg: RppSettings, x: float,
+             y: float, th: float, v0: float, w0: float, i0: int,
+             s0: float) -> tuple[float, float, int, float, int, float, float]:
     """One tick: ``(v, omega, segment, progress, mode, carrot_x, carrot_y)`` (see the module
     docstring; ``cfg`` from :func:`pack_settings`, ``(v0, w0)`` the last command)."""
     n = path.shape[0]
-    dt = cfg[S_DT]
-    i, s = closest_progress(path, cum, x, y, i0, s0, cfg[S_SEARCH])
+    dt = cfg.dt_s
+    i, s = closest_progress(path, cum, x, y, i0, s0, cfg.pose_search_distance_m)
     gx, gy = path[n - 1, 0], path[n - 1, 1]
     d_goal = max(cum[n - 1] - s, math.hypot(gx - x, gy - y))
     c, sn = math.cos(th), math.sin(th)
-    clear = cfg[S_CLEAR]
-    gap_c = segment_static_distance(occ, ox, oy, res, x, y, x, y,
-                                    cfg[S_RADIUS] + max(cfg[S_PROX], 0.0) + clear)
+    clear = cm.clear_m
+    gap_c = segment_distance(cm, x, y, x, y,
+                                    cm.radius_m + max(cfg.proximity_distance_m, 0.0) + clear)
     if gap_c < clear:  # already closer (a robot that braked late): keep what it has
         clear = gap_c * (1.0 - 1e-12)
-    la0 = lookahead_distance(v0, cfg[S_LA_TIME], cfg[S_LA_MIN], cfg[S_LA_MAX])
-    rot = cfg[S_ROT]
-    wmax = cfg[S_WMAX]
-    alpha = cfg[S_ALPHA]
+    la0 = lookahead_distance(v0, cfg.lookahead_time_s, cfg.min_lookahead_m,
+                             cfg.max_lookahead_m)
+    rot = cfg.rotate_min_angle_rad
+    wmax = cfg.max_yaw_rate_radps
+    alpha = cfg.max_yaw_accel_radps2
     # the carrot candidates: la0, 0.7 la0, 0.49 la0, ... down to the floor
-    floor = min(la0, _MIN_CARROT * cfg[S_LA_MIN])
+    floor = min(la0, _MIN_CARROT * cfg.min_lookahead_m)
     cand = np.empty((SHRINKS + 1, 2))
     nc = 0
     la = la0
     for _ in range(SHRINKS + 1):
         qx, qy = carrot_point(path, cum, i, s, x, y, la)
-        cand[nc, 0], cand[nc, 1] = _off_the_wall(occ, ox, oy, res, qx, qy, cfg[S_CLEAR])
+        cand[nc, 0], cand[nc, 1] = _off_the_wall(cm, qx, qy, cm.clear_m)
         nc += 1
         if la <= floor:
             break
         la = max(la * _SHRINK, floor)
     # which one, and whether to turn on the spot first (by ``turn`` rad)
     pick, turn = 0, math.nan
-    if cfg[S_CLEAR_CARROT] != 0.0:
-        pick = _clear_candidate(occ, ox, oy, res, x, y, th, cand, nc, rot, clear)
+    if cfg.clear_carrot:
+        pick = _clear_candidate(cm, x, y, th, cand, nc, rot, clear)
         if pick < 0:  # no arc is clear: the straight line after a turn on the spot
-            pick = _clear_candidate(occ, ox, oy, res, x, y, th, cand, nc, 0.0, clear)
+            pick = _clear_candidate(cm, x, y, th, cand, nc, 0.0, clear)
             if pick >= 0:
                 xr, yr = _in_frame(cand[pick, 0], cand[pick, 1], x, y, c, sn)
                 turn = math.atan2(yr, xr)
         if pick < 0:  # nor a line: a heading nearby from which an arc is
             for j in range(2 * len(_TURNS)):
                 d = _TURNS[j // 2] * (1.0 if j % 2 == 0 else -1.0)
-                pick = _clear_candidate(occ, ox, oy, res, x, y, th + d, cand, nc, rot, clear)
+                pick = _clear_candidate(cm, x, y, th + d, cand, nc, rot, clear)
                 if pick >= 0:
                     turn = d
                     break
@@ -382,10 +396,11 @@ def rpp_step(path: np.ndarray, cum: np.ndarray, occ: np.ndarray, ox: float, oy: 
     if abs(bearing) > rot:
         return 0.0, _turn_rate(bearing, dt, wmax, alpha), i, s, MODE_ROTATE, px, py
     kappa = pursuit_curvature(xr, yr)
-    amax = cfg[S_AMAX]
-    v = regulated_speed(cfg[S_VMAX], kappa, gap_c - cfg[S_RADIUS], d_goal, amax, dt,
-                        cfg[S_RMIN], cfg[S_VREG], cfg[S_PROX], cfg[S_APPROACH],
-                        cfg[S_VAPPROACH])
+    amax = cfg.max_accel_mps2
+    v = regulated_speed(cfg.max_speed_mps, kappa, gap_c - cm.radius_m, d_goal, amax, dt,
+                        cfg.regulated_min_radius_m, cfg.regulated_min_speed_mps,
+                        cfg.proximity_distance_m, cfg.approach_distance_m,
+                        cfg.min_approach_speed_mps)
     # the windows the acceleration limits reach this tick (as the world clips)
     vlo, vhi = v0 - amax * dt, v0 + amax * dt
     v = min(max(v, max(vlo, 0.0)), vhi)
@@ -405,7 +420,7 @@ def rpp_step(path: np.ndarray, cum: np.ndarray, occ: np.ndarray, ox: float, oy: 
         if vk <= 0.0:
             break
         wk = min(max(vk * kappa, wlo), whi)
-        if unicycle_stop_clear(occ, ox, oy, res, x, y, th, vk, wk, dt, amax, alpha, clear):
+        if unicycle_stop_clear(cm, x, y, th, vk, wk, dt, amax, alpha, clear):
             return vk, vk * kappa, i, s, MODE_PURSUIT, px, py
     # none: the arc as it is (the shield then takes the nearest command it can stop from,
     # turning too; standing still here could last for ever on a path with no slack)
@@ -422,12 +437,9 @@ class RegulatedPurePursuit:
 
     def __init__(self, problem: Any, params: Any, dt: float, max_speed: float) -> None:
         g = problem.grid
-        self.occ = g.occupied
-        self.ox, self.oy = float(g.origin[0]), float(g.origin[1])
-        self.res = float(g.resolution)
+        self.costmap = costmap_for(g, float(problem.robot_radius_m))
         self.goal = np.asarray(problem.goal, dtype=np.float64)
-        self.cfg = pack_settings(params, problem.robot, float(dt), float(max_speed),
-                                 float(problem.robot_radius_m), self.res)
+        self.cfg = pack_settings(params, problem.robot, float(dt), float(max_speed))
         self._source: np.ndarray | None = None
         self.path = np.zeros((0, 2))
         self.cum = np.zeros(0)
@@ -454,7 +466,7 @@ class RegulatedPurePursuit:
             self.set_path(path)
         cmd = obs.command
         v, w, i, s, mode, cx, cy = rpp_step(
-            self.path, self.cum, self.occ, self.ox, self.oy, self.res, self.cfg,
+            self.path, self.cum, self.costmap, self.cfg,
             float(obs.position[0]), float(obs.position[1]), float(obs.heading),
             float(cmd[0]), float(cmd[1]), self.segment, self.progress_m)
         self.segment, self.progress_m = int(i), float(s)
@@ -464,18 +476,16 @@ class RegulatedPurePursuit:
 
 
 def warmup_rpp() -> None:
-    """Compile (or load from numba's cache) the follower's kernel, for writeable and
-    read-only maps."""
+    """Compile (or load from numba's cache) the follower's kernel (a
+    :class:`~pathfuse.costmap.Costmap`'s map is always read-only)."""
     from pathfuse.planners.params import PursuitParams
     from pathfuse.robot import RobotModel
 
-    cfg = pack_settings(PursuitParams(), RobotModel.diff_drive(radius_m=0.2), 0.1, 1.0, 0.2,
-                        0.5)
+    cfg = pack_settings(PursuitParams(), RobotModel.diff_drive(radius_m=0.2), 0.1, 1.0)
     path = np.array([[0.75, 0.75], [2.25, 0.75], [2.25, 2.25]])
     cum = _cumlen(path)
-    for ro in (False, True):
-        occ = np.zeros((6, 6), dtype=np.bool_)
-        occ[3, 1] = True
-        occ.setflags(write=not ro)
-        for th in (0.0, 3.0):  # the pursuit arc and a turn on the spot
-            rpp_step(path, cum, occ, 0.0, 0.0, 0.5, cfg, 0.75, 0.75, th, 0.5, 0.0, 0, 0.0)
+    occ = np.zeros((6, 6), dtype=np.bool_)
+    occ[3, 1] = True
+    cm = make_costmap(occ, 0.2, resolution_m=0.5)
+    for th in (0.0, 3.0):  # the pursuit arc and a turn on the spot
+        rpp_step(path, cum, cm, cfg, 0.75, 0.75, th, 0.5, 0.0, 0, 0.0)

@@ -155,7 +155,7 @@ def test_dwell_shortfall_matches_a_sampled_lane():
         rd = rng.uniform(0.1, 0.4, n)
         px, py = rng.uniform(-2, 2, 2)
         t, dwell = float(rng.uniform(0, 2)), float(rng.uniform(0.2, 3))
-        got = dwell_shortfall(px, py, t, q, v, rd, 0.25, dwell, 0.5)
+        got = dwell_shortfall(px, py, t, q, v, rd, 0.25, dwell, 0.5, np.zeros(0, dtype=bool))
         want = _brute_dwell(px, py, t, q, v, rd, 0.25, dwell, 0.5)
         assert got == pytest.approx(want, abs=2e-3)
         hits += got > 0
@@ -195,3 +195,33 @@ def test_dwell_critic_moves_dwa_out_of_a_walkers_lane():
     v_off, v_on = speed(dwell_s=0.0), speed(dwell_s=3.0)
     assert v_off == pytest.approx(1.0)
     assert v_on < 0.8
+
+
+def test_steady_discs_tell_walkers_from_wanderers():
+    """The dwell critic counts a disc only once it has kept its velocity for a second: a
+    disc on a straight leg is steady after that, one whose heading random-walks (pathfuse's
+    random walkers: 1 rad/sqrt(s)) seldom is, a disc at rest always is."""
+    from pathfuse.planners.controllers.social import STEADY_S, SteadyDiscs
+
+    dt = 0.1
+    rng = np.random.default_rng(0)
+    sd = SteadyDiscs(dt)
+    ids = np.array([0, 1, 2])
+    heading = 0.0
+    steady = []
+    n_warm = int(round(STEADY_S / dt))
+    for t in range(400):
+        heading += rng.normal(0.0, 1.0 * np.sqrt(dt))
+        dvel = np.array([[0.8, 0.0], [0.6 * np.cos(heading), 0.6 * np.sin(heading)],
+                         [0.0, 0.0]])
+        m = sd.update(ids, dvel)
+        if t < n_warm:
+            assert not m.any()  # not sensed long enough yet
+        else:
+            steady.append(m.copy())
+    steady = np.array(steady)
+    assert steady[:, 0].all() and steady[:, 2].all()
+    assert steady[:, 1].mean() < 0.3
+    # a disc no longer sensed is forgotten: back, it must be steady for a second again
+    sd.update(np.array([0]), np.array([[0.8, 0.0]]))
+    assert not sd.update(np.array([1]), np.array([[0.6, 0.0]]))[0]

@@ -206,7 +206,9 @@ class PersonalSpaceParams(Checked):
     dwell_s: float = param(0.0, ge=0, le=30, unit="s",
                            help="yield outside a walker's lane (ours): a rollout pays "
                                 "dwell_weight where it ends within personal_m of the lane a "
-                                "sensed disc, predicted at constant velocity, sweeps in the "
+                                "sensed disc (in mppi and the fusion only a steady one, that "
+                                "kept its velocity for 1 s), predicted at constant velocity, "
+                                "sweeps in the "
                                 "dwell_s after the rollout (the spot where the robot may have "
                                 "to stand); 0 = off")
     dwell_weight: float = param(50.0, ge=0, le=1e6,

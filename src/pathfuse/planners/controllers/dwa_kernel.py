@@ -19,7 +19,7 @@ from numba import njit
 
 from pathfuse.costmap import Discs, segment_distance
 from pathfuse.geometry import MARGIN_FRAC
-from pathfuse.planners.controllers.social import dwell_shortfall
+from pathfuse.planners.controllers.social import EVERY_DISC, dwell_shortfall
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
 from pathfuse.sweep import arc_deviation_bound, disc_sweep_gaps, unicycle_pose
 
@@ -388,7 +388,7 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
     if n_disc > 0 and f.dwell_s > 0.0 and f.dwell_weight > 0.0:
         # ours (the dwell critic): the robot may have to stand where the rollout ends
         dwc = f.dwell_weight * dwell_shortfall(ex, ey, tend, dpos, dvel, drad, radius,
-                                               f.dwell_s, personal)
+                                               f.dwell_s, personal, EVERY_DISC)
     # the end point against the path near the progress index: its distance to the path and
     # how much path is left beyond its projection
     m = pts.shape[0]

@@ -145,7 +145,8 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
     dwell_s: float = param(1.5, ge=0, le=30, unit="s",
                            help="yield outside a walker's lane (ours, among discs): a rollout "
                                 "pays dwell_weight where it ends within personal_m of the lane "
-                                "a sensed disc, predicted at constant velocity, sweeps in the "
+                                "a steady sensed disc (one that kept its velocity for 1 s), "
+                                "predicted at constant velocity, sweeps in the "
                                 "dwell_s after the rollout; 0 = off (the default of dwa and "
                                 "mppi)")
     velocity_space: bool = param(True, help="diff-drive robot online: choose (v, omega) from "

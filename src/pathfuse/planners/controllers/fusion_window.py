@@ -74,7 +74,7 @@ from pathfuse.planners.controllers.dwa_kernel import (
     relaxed,
     route_tangent,
 )
-from pathfuse.planners.controllers.social import PassingSides, disc_ids
+from pathfuse.planners.controllers.social import PassingSides, SteadyDiscs, disc_ids
 
 __all__ = ["ForceWindow", "PASSIVE_WINDOW"]
 
@@ -141,6 +141,8 @@ class ForceWindow:
             personal_m=sp.personal_m, w_side=sp.side_weight if sp.social else 0.0,
             dwell_s=sp.dwell_s if sp.social else 0.0, w_dwell=sp.dwell_weight)
         self.sides = PassingSides(sp.personal_m)
+        self.steady = SteadyDiscs(float(dt))
+        self._steady = np.zeros(0, dtype=np.bool_)
         self.steps = max(1, int(math.ceil(p.horizon_s / dt)))
         """Algorithm 2's moves looked ahead each tick (the rollouts' horizon)."""
         self.min_reach_m = 0.25 * self.steps * self.vmax * dt
@@ -228,6 +230,8 @@ class ForceWindow:
         x = float(obs.position[0])
         y = float(obs.position[1])
         dpos, dvel, drad = sensed_discs(obs)
+        # the dwell critic counts the discs that keep their velocity (social.SteadyDiscs)
+        self._steady = self.steady.update(disc_ids(obs, drad.shape[0]), dvel)
         lc = polyline_cumlen(local)
         net = math.hypot(float(local[-1, 0]) - x, float(local[-1, 1]) - y)
         if self.relax_replan:
@@ -308,7 +312,7 @@ class ForceWindow:
         cmd = obs.command
         self.sequenced += 1
         a0, a1 = m._choose(float(obs.position[0]), float(obs.position[1]), float(obs.heading),
-                           float(cmd[0]), float(cmd[1]), dpos, dvel, drad)
+                           float(cmd[0]), float(cmd[1]), dpos, dvel, drad, self._steady)
         return np.array([a0, a1])
 
     def _rotate(self, err: float) -> np.ndarray:

@@ -93,6 +93,7 @@ from pathfuse.grid import GridMap
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
 from pathfuse.planners.controllers.mppi_kernel import mppi_optimise, pack_mppi, path_inflation
 from pathfuse.planners.controllers.replan import replan_around_discs
+from pathfuse.planners.controllers.social import EVERY_DISC, SteadyDiscs, disc_ids
 from pathfuse.planners.params import GlobalAStarParams, PersonalSpaceParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -278,6 +279,7 @@ class MPPIController(Controller):
         self.colliding_ticks = 0
         self.offline_shield = np.zeros(5, dtype=np.int64)
         self._sensed = _NO_DISCS
+        self.steady = SteadyDiscs(self.tick_s)
 
     # ------------------------------------------------------------------ the path
     def _set_path(self, pts: np.ndarray) -> None:
@@ -309,7 +311,8 @@ class MPPIController(Controller):
 
     # ------------------------------------------------------------------ one decision
     def _choose(self, x: float, y: float, th: float, c0: float, c1: float, dpos: np.ndarray,
-                dvel: np.ndarray, drad: np.ndarray) -> tuple[float, float]:
+                dvel: np.ndarray, drad: np.ndarray,
+                dsteady: np.ndarray = EVERY_DISC) -> tuple[float, float]:
         if self.replan_every and self.ticks and self.ticks % self.replan_every == 0:
             self._replan(x, y)
         g = self.problem.grid
@@ -326,7 +329,7 @@ class MPPIController(Controller):
         a0, a1, _, free = mppi_optimise(self.costmap, self.f, x, y, th, c0, c1,
                                         self.nominal, self.noise, self.ctrl, self.weights,
                                         self.pts, self.cum, self.pexp, self.k, goal_mode, dpos,
-                                        dvel, drad)
+                                        dvel, drad, dsteady)
         if free == 0:
             self.colliding_ticks += 1
         return float(a0), float(a1)
@@ -336,10 +339,12 @@ class MPPIController(Controller):
         """``(v, omega)`` for a diff-drive robot, ``(vx, vy)`` for a holonomic one."""
         dpos, dvel, drad = sensed_discs(obs)
         self._sensed = (dpos, dvel, drad)
+        # the dwell critic counts the discs that keep their velocity (social.SteadyDiscs)
+        steady = self.steady.update(disc_ids(obs, drad.shape[0]), dvel)
         cmd = obs.command
         a0, a1 = self._choose(float(obs.position[0]), float(obs.position[1]),
                               float(obs.heading), float(cmd[0]), float(cmd[1]), dpos, dvel,
-                              drad)
+                              drad, steady)
         return np.array([a0, a1])
 
     # ------------------------------------------------------------------ offline
@@ -479,7 +484,7 @@ class MPPIController(Controller):
                 q.setflags(write=not ro)
                 mppi_optimise(c.costmap, c.f, 0.5, 0.5, 0.0, 0.0, 0.0, c.nominal,
                               c.noise, c.ctrl, c.weights, c.pts, c.cum, c.pexp, 0, False,
-                              q, q, np.ones(1))
+                              q, q, np.ones(1), np.ones(1, dtype=np.bool_))
         _WARM[0] = True
 
 

@@ -321,7 +321,7 @@ def _brake(seq, f, c0, c1):
 
 @njit(cache=True)
 def _score(seq, cm, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_mode, dpos,
-           dvel, drad):
+           dvel, drad, dsteady):
     """The cost of one control sequence (the critics, summed with their weights)."""
     n = seq.shape[0]
     holo = f.holonomic
@@ -451,7 +451,7 @@ def _score(seq, cm, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_mode, dpo
     if f.dwell_s > 0.0 and f.dwell_weight > 0.0 and not hit:
         # ours (the dwell critic): the robot may have to stand where the rollout ends
         cost += f.dwell_weight * dwell_shortfall(px, py, tnow, dpos, dvel, drad, radius,
-                                                 f.dwell_s, f.personal_m)
+                                                 f.dwell_s, f.personal_m, dsteady)
     if goal_mode:
         cost += f.goal_weight * goal / n
     else:
@@ -466,7 +466,7 @@ def _score(seq, cm, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_mode, dpo
 
 @njit(cache=True)
 def mppi_optimise(cm, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, pts, cum,
-                  pexp, k0, goal_mode, dpos, dvel, drad):
+                  pexp, k0, goal_mode, dpos, dvel, drad, dsteady):
     """One MPPI update from the pose ``(x, y, th)`` and the last command ``(c0, c1)``.
 
     ``cm`` is the static map with the robot's radius and the clearance lattice, ``f`` the
@@ -508,7 +508,7 @@ def mppi_optimise(cm, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, pts, cum
     free = 0
     for k in range(nk):
         c, hit = _score(ctrl[k], cm, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0,
-                        goal_mode, dpos, dvel, drad)
+                        goal_mode, dpos, dvel, drad, dsteady)
         costs[k] = c
         if c < best:
             best = c
@@ -534,7 +534,7 @@ def mppi_optimise(cm, f, x, y, th, c0, c1, nominal, noise, ctrl, costs, pts, cum
     # the guide instead when it scores better than the mean (ours: on an open path the
     # noise's weighted mean is never exactly straight, the guide is)
     mean, _ = _score(nominal, cm, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0,
-                     goal_mode, dpos, dvel, drad)
+                     goal_mode, dpos, dvel, drad, dsteady)
     if f.keep_better_guide and guide <= mean:
         for t in range(n):
             nominal[t, 0] = ctrl[1, t, 0]

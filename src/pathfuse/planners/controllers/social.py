@@ -39,7 +39,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-__all__ = ["PassingSides", "disc_ids", "dwell_shortfall", "COMMIT_M", "BEHIND_M"]
+__all__ = ["PassingSides", "SteadyDiscs", "disc_ids", "dwell_shortfall", "COMMIT_M", "BEHIND_M",
+           "STEADY_S", "EVERY_DISC"]
 
 COMMIT_M = 1.0
 """A disc whose predicted gap to the chosen command's rollout is below ``personal_m``
@@ -99,6 +100,73 @@ class PassingSides:
         self.committed = keep
 
 
+EVERY_DISC = np.zeros(0, dtype=np.bool_)
+"""The steady mask meaning every sensed disc (:func:`dwell_shortfall`)."""
+
+STEADY_S = 1.0
+"""A disc is *steady* (the dwell critic counts it) once it has kept its velocity this long."""
+STEADY_RAD = math.radians(20.0)
+"""... its direction within this of the present one ..."""
+STEADY_SPEED_MPS = 0.1
+"""... and its speed within this (or 20 % of the present speed, whichever is larger)."""
+
+
+class SteadyDiscs:
+    """Which sensed discs have kept their velocity over the last :data:`STEADY_S` (ours).
+
+    The dwell critic extrapolates a disc's lane beyond the rollouts' horizon; that only
+    makes sense for a disc that walks somewhere (a person on their way, a disc on a straight
+    leg), not for one that wanders.  A disc is steady when it has been sensed for
+    :data:`STEADY_S` and every velocity sensed in that time is within :data:`STEADY_RAD` of
+    the present one's direction and within :data:`STEADY_SPEED_MPS` (or 20 %) of its speed;
+    a disc slower than :data:`STEADY_SPEED_MPS` is steady (its lane is where it stands).
+
+    Examples
+    --------
+    >>> sd = SteadyDiscs(dt=0.5)                 # two ticks make a second
+    >>> ids = np.array([1, 2])
+    >>> sd.update(ids, np.array([[1.0, 0.0], [1.0, 0.0]])).tolist()
+    [False, False]
+    >>> _ = sd.update(ids, np.array([[1.0, 0.0], [0.0, 1.0]]))   # disc 2 turns
+    >>> sd.update(ids, np.array([[1.0, 0.05], [0.0, 1.0]])).tolist()
+    [True, False]
+    """
+
+    def __init__(self, dt: float, steady_s: float = STEADY_S) -> None:
+        self.n = max(1, int(round(steady_s / float(dt))))
+        self.hist: dict[int, list[tuple[float, float]]] = {}
+
+    def update(self, ids: np.ndarray, dvel: np.ndarray) -> np.ndarray:
+        """Record this tick's velocities ``dvel`` of the discs ``ids``; the steady mask."""
+        out = np.zeros(len(ids), dtype=np.bool_)
+        hist: dict[int, list[tuple[float, float]]] = {}
+        for j, i in enumerate(ids):
+            h = self.hist.get(int(i), [])
+            vx, vy = float(dvel[j, 0]), float(dvel[j, 1])
+            h = (h + [(vx, vy)])[-(self.n + 1):]
+            hist[int(i)] = h
+            sp = math.hypot(vx, vy)
+            if len(h) <= self.n:
+                continue
+            if sp < STEADY_SPEED_MPS:
+                out[j] = True
+                continue
+            tol = max(STEADY_SPEED_MPS, 0.2 * sp)
+            ok = True
+            for ux, uy in h[:-1]:
+                su = math.hypot(ux, uy)
+                if abs(su - sp) > tol or su == 0.0:
+                    ok = False
+                    break
+                c = (ux * vx + uy * vy) / (su * sp)
+                if math.acos(max(-1.0, min(1.0, c))) > STEADY_RAD:
+                    ok = False
+                    break
+            out[j] = ok
+        self.hist = hist
+        return out
+
+
 def disc_ids(obs: Any, n: int) -> np.ndarray:
     """The sensed discs' identities (their indices in the scenario), or ``0..n-1`` when the
     observation carries none."""
@@ -109,13 +177,31 @@ def disc_ids(obs: Any, n: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def dwell_shortfall(px, py, t, dpos, dvel, drad, radius, dwell_s, personal_m):
+def _lane_shortfall(px, py, t, qx, qy, vx, vy, rd, radius, dwell_s, personal_m):
+    """One disc's term of :func:`dwell_shortfall`."""
+    ax = qx + vx * t
+    ay = qy + vy * t
+    bx = vx * dwell_s
+    by = vy * dwell_s
+    l2 = bx * bx + by * by
+    u = 0.0
+    if l2 > 0.0:
+        u = min(1.0, max(0.0, ((px - ax) * bx + (py - ay) * by) / l2))
+    g = math.hypot(px - ax - u * bx, py - ay - u * by) - radius - rd
+    if g < personal_m:
+        return (personal_m - max(g, 0.0)) / personal_m * (1.0 - 0.5 * u)
+    return 0.0
+
+
+@njit(cache=True)
+def dwell_shortfall(px, py, t, dpos, dvel, drad, radius, dwell_s, personal_m, steady):
     """The dwell critic of a rollout ending at ``(px, py)`` at time ``t`` (see the module
-    docstring): over the sensed discs, the largest ``(personal_m - gap) / personal_m``
-    (gap clipped at 0) times ``1 - u / 2``, where ``gap`` is the least distance between
-    the robot's disc standing there and disc ``i`` moving on from ``dpos[i] + dvel[i] t``
-    at ``dvel[i]`` for ``dwell_s``, and ``u`` in [0, 1] is when in ``dwell_s`` it comes
-    closest.  0 when no disc comes within ``personal_m``.
+    docstring): over the sensed discs ``i`` with ``steady[i]`` (every disc when ``steady``
+    is empty), the largest ``(personal_m - gap) / personal_m`` (gap clipped at 0) times
+    ``1 - u / 2``, where ``gap`` is the least distance between the robot's disc standing
+    there and disc ``i`` moving on from ``dpos[i] + dvel[i] t`` at ``dvel[i]`` for
+    ``dwell_s``, and ``u`` in [0, 1] is when in ``dwell_s`` it comes closest.  0 when no
+    such disc comes within ``personal_m``.
 
     Examples
     --------
@@ -123,26 +209,22 @@ def dwell_shortfall(px, py, t, dpos, dvel, drad, radius, dwell_s, personal_m):
     >>> v = np.array([[0.0, 1.0]])               # a disc walking along +y at x = 3
     >>> r = np.array([0.25])
     >>> p = np.array([[3.0, -1.0]])
-    >>> round(dwell_shortfall(3.0, 0.0, 0.0, p, v, r, 0.25, 1.5, 0.5), 3)   # in its lane
+    >>> every = np.zeros(0, dtype=np.bool_)
+    >>> round(dwell_shortfall(3.0, 0.0, 0.0, p, v, r, 0.25, 1.5, 0.5, every), 3)  # in its lane
     0.667
-    >>> dwell_shortfall(1.5, 0.0, 0.0, p, v, r, 0.25, 1.5, 0.5)   # 1.5 m beside it
+    >>> dwell_shortfall(1.5, 0.0, 0.0, p, v, r, 0.25, 1.5, 0.5, every)   # 1.5 m beside it
     0.0
-    >>> dwell_shortfall(3.0, 0.0, 0.0, p, z, r, 0.25, 1.5, 0.5)   # standing 1 m away
+    >>> dwell_shortfall(3.0, 0.0, 0.0, p, z, r, 0.25, 1.5, 0.5, every)   # standing 1 m away
+    0.0
+    >>> dwell_shortfall(3.0, 0.0, 0.0, p, v, r, 0.25, 1.5, 0.5, np.array([False]))  # wanders
     0.0
     """
     worst = 0.0
+    every = steady.shape[0] == 0
     for i in range(drad.shape[0]):
-        ax = dpos[i, 0] + dvel[i, 0] * t
-        ay = dpos[i, 1] + dvel[i, 1] * t
-        bx = dvel[i, 0] * dwell_s
-        by = dvel[i, 1] * dwell_s
-        l2 = bx * bx + by * by
-        u = 0.0
-        if l2 > 0.0:
-            u = min(1.0, max(0.0, ((px - ax) * bx + (py - ay) * by) / l2))
-        g = math.hypot(px - ax - u * bx, py - ay - u * by) - radius - drad[i]
-        if g < personal_m:
-            sh = (personal_m - max(g, 0.0)) / personal_m * (1.0 - 0.5 * u)
+        if every or steady[i]:
+            sh = _lane_shortfall(px, py, t, dpos[i, 0], dpos[i, 1], dvel[i, 0], dvel[i, 1],
+                                 drad[i], radius, dwell_s, personal_m)
             if sh > worst:
                 worst = sh
     return worst

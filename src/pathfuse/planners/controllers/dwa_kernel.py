@@ -17,11 +17,11 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from pathfuse.costmap import Discs, segment_distance
+from pathfuse.costmap import Discs, field_distance, segment_distance
 from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.controllers.social import dwell_shortfall
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
-from pathfuse.sweep import arc_deviation_bound, disc_sweep_gaps, unicycle_pose
+from pathfuse.sweep import arc_deviation_bound, unicycle_pose
 
 __all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "relaxed", "dwa_tick",
            "keep_reference", "route_tangent", "DwaSettings", "DwaTick"]
@@ -228,12 +228,62 @@ def path_gap(cm, s, pts, cum, k, length):
     return best - radius
 
 
+@njit(cache=True, inline="always")
+def _sweep_gap(ax, ay, bx, by, radius, qax, qay, qbx, qby, rq):
+    """:func:`pathfuse.sweep.disc_sweep_gaps` for one disc, on scalars (the same arithmetic
+    in the same order, without its arrays): the least surface gap over a tick between the
+    robot moving ``a -> b`` and a disc of radius ``rq`` moving ``qa -> qb``."""
+    d0x = ax - qax
+    d0y = ay - qay
+    ddx = (bx - ax) - (qbx - qax)
+    ddy = (by - ay) - (qby - qay)
+    l2 = ddx * ddx + ddy * ddy
+    u = 0.0
+    if l2 > 0.0:
+        u = -(d0x * ddx + d0y * ddy) / l2
+        u = min(1.0, max(0.0, u))
+    ex = d0x + u * ddx
+    ey = d0y + u * ddy
+    return math.sqrt(ex * ex + ey * ey) - radius - rq
+
+
+@njit(cache=True, inline="always")
+def _segment_distance(cm, ax, ay, bx, by, cap, slack):
+    """:func:`pathfuse.costmap.segment_distance`, the same value, with an exact shortcut:
+    when the costmap's clearance lattice (a lower bound of the distance to the occupied
+    squares, :func:`pathfuse.costmap.field_distance`, at the segment's midpoint less half
+    its length) puts every square beyond ``cap`` (with 1e-9 to spare for rounding), no
+    square can lower the result, which is then ``cap`` or the distance to the map's edge
+    (computed as :func:`pathfuse.sweep.segment_static_distance` does)."""
+    half = 0.5 * math.hypot(bx - ax, by - ay)
+    lb, _ = field_distance(cm, 0.5 * (ax + bx), 0.5 * (ay + by))
+    if not (lb - half > cap + 1e-9 * (1.0 + cap)):
+        return segment_distance(cm, ax, ay, bx, by, cap, slack)
+    h, w = cm.occ.shape
+    xmin = cm.ox_m
+    ymin = cm.oy_m
+    xmax = cm.ox_m + w * cm.res_m
+    ymax = cm.oy_m + h * cm.res_m
+    best = cap
+    for i in range(2):
+        px = ax if i == 0 else bx
+        py = ay if i == 0 else by
+        de = min(px - xmin, xmax - px, py - ymin, ymax - py)
+        if de < 0.0 or (de == 0.0 and slack == 0.0):
+            return 0.0
+        de += slack
+        if de < best:
+            best = de
+    return best
+
+
 @njit(cache=True)
 def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
-             ty, dside, sides):
+             ty, dside, sides, reach):
     """Score one sample: ``out = [cost, admissible, first_tick_clear]``; ``sides[j] = (side,
     least predicted gap)`` of the sample against sensed disc ``j`` (the social critics,
-    :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction)."""
+    :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction);
+    ``reach`` is scratch space of one float per disc (allocated once per tick)."""
     res = cm.res_m
     dt = f.dt_s
     radius = cm.radius_m
@@ -259,12 +309,6 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
     travelled = 0.0
     n_disc = drad.shape[0]
     dyn = 0.0
-    qa = np.empty((1, 2))
-    qb = np.empty((1, 2))
-    rr = np.empty(1)
-    pa = np.empty(2)
-    pb = np.empty(2)
-    reach = np.empty(n_disc)
     stop_s = dt + (speed / amax if math.isfinite(amax) and amax > 0.0 else 0.0)
     if not f.passive:
         stop_s = 0.0
@@ -290,14 +334,14 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
     for i in range(1, n + 1):
         t = min(i * h, horizon)
         bx, by, bth = unicycle_pose(x, y, th, v, w, t)
-        d = segment_distance(cm, ax, ay, bx, by, cap, slack) - e
+        d = _segment_distance(cm, ax, ay, bx, by, cap, slack) - e
         if t <= dt + 1e-12:
             # the tick itself: the arc (lower bound) and the chord (the path offline) clear
             if d < clear:
                 first_ok = False
                 ok = False
                 break
-            if e > 0.0 and segment_distance(cm, ax, ay, bx, by, clear, slack) < clear:
+            if e > 0.0 and _segment_distance(cm, ax, ay, bx, by, clear, slack) < clear:
                 first_ok = False
                 ok = False
                 break
@@ -316,24 +360,19 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
             if pdi < np.inf:
                 align += pdi
                 n_align += 1
+        t0 = t - h if t - h > 0.0 else 0.0
         for j in range(n_disc):
-            pa[0] = ax
-            pa[1] = ay
-            pb[0] = bx
-            pb[1] = by
-            t0 = t - h if t - h > 0.0 else 0.0
-            qa[0, 0] = dpos[j, 0] + dvel[j, 0] * t0
-            qa[0, 1] = dpos[j, 1] + dvel[j, 1] * t0
-            qb[0, 0] = dpos[j, 0] + dvel[j, 0] * t
-            qb[0, 1] = dpos[j, 1] + dvel[j, 1] * t
-            rr[0] = drad[j]
+            qax = dpos[j, 0] + dvel[j, 0] * t0
+            qay = dpos[j, 1] + dvel[j, 1] * t0
+            qbx = dpos[j, 0] + dvel[j, 0] * t
+            qby = dpos[j, 1] + dvel[j, 1] * t
             # less how far the disc can come while the robot stops from here (so a pass
             # that the shield's passive-safety test would refuse counts as a collision)
-            g0 = disc_sweep_gaps(pa, pb, radius, qa, qb, rr)[0] - e
+            g0 = _sweep_gap(ax, ay, bx, by, radius, qax, qay, qbx, qby, drad[j]) - e
             if g0 < sides[j, 1]:
                 # the side of the route the disc is on at the closest approach so far
-                mx = 0.5 * (qa[0, 0] + qb[0, 0]) - 0.5 * (ax + bx)
-                my = 0.5 * (qa[0, 1] + qb[0, 1]) - 0.5 * (ay + by)
+                mx = 0.5 * (qax + qbx) - 0.5 * (ax + bx)
+                my = 0.5 * (qay + qby) - 0.5 * (ay + by)
                 # (the disc's signed offset from the robot across the route; a pass only
                 # where the two are side by side, not one behind the other)
                 cr = tx * my - ty * mx
@@ -503,6 +542,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
     discs = Discs(dpos, dvel, dspeed, drad)
     nd = drad.shape[0]
     sides = np.zeros((nd, 2))
+    reach = np.empty(nd)  # _rollout's scratch (one allocation per tick, not per sample)
     for j in range(nd):
         chosen[j, 0] = 0.0
         chosen[j, 1] = np.inf
@@ -535,7 +575,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                 sp = math.hypot(ux, uy)
                 hd = math.atan2(uy, ux) if sp > 0.0 else th
                 _rollout(cm, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg,
-                         dpos, dvel, drad, out, tx, ty, dside, sides)
+                         dpos, dvel, drad, out, tx, ty, dside, sides, reach)
                 if out[1] == 1.0 and n_disc > 0:
                     out[0] += _passive_penalty(holonomic_stop_disc_gap(
                         x, y, ux, uy, dt, amax, cm.radius_m, discs))
@@ -566,7 +606,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
             else:
                 w = min(max(0.0, wlo), whi)  # always try going straight
             _rollout(cm, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, dpos, dvel,
-                     drad, out, tx, ty, dside, sides)
+                     drad, out, tx, ty, dside, sides, reach)
             if out[1] == 1.0 and n_disc > 0:
                 out[0] += _passive_penalty(unicycle_stop_disc_gap(
                     x, y, th, v, w, dt, amax, f.max_yaw_accel_radps2, cm.radius_m, discs))

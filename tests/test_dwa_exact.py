@@ -6,7 +6,7 @@ import numpy as np
 
 from pathfuse.costmap import costmap_for, segment_distance
 from pathfuse.grid import GridMap
-from pathfuse.planners.controllers.dwa_kernel import _segment_distance, _sweep_gap
+from pathfuse.planners.controllers.dwa_checks import _segment_distance, _sweep_gap
 from pathfuse.sweep import disc_sweep_gaps
 
 

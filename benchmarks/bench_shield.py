@@ -76,7 +76,7 @@ def main() -> None:
     w0 = time.perf_counter()
     for sc, p, th, prev, cmd in data:
         g = sc.grid
-        rb = sc.robot.to_model()
+        rb = sc.robot
         cm = costmap_for(g, rb.radius_m)
         clear = cm.clear_m
         lim = (rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2, rb.max_yaw_rate_radps,

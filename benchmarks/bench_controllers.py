@@ -59,9 +59,9 @@ def main() -> None:
     for model in ("holonomic", "diff-drive"):
         for name in names:
             def run(sc, name=name, model=model):
-                rb = {"model": model, "radius": sc.robot.radius,
-                      "sensing_radius": sc.robot.sensing_radius,
-                      "max_speed": sc.robot.max_speed}
+                rb = {"model": model, "radius": sc.robot.radius_m,
+                      "sensing_radius": sc.robot.sensing_radius_m,
+                      "max_speed": sc.robot.max_speed_mps}
                 return pathfuse.simulate(sc, planner=name, robot=rb)
 
             run(scs[0])  # warm-up: numba compilation stays out

@@ -6,7 +6,10 @@ of ``tests/data/barn``, the diff-drive Jackal-sized disc at 2 m/s, ``dwa``
 driving, the shield on) and times, on each state:
 
 * ``shield (asked)``: :func:`~pathfuse.shield.shield_unicycle` on the command
-  the robot really applied (what almost every tick costs: the command passes);
+  the robot really applied (what almost every tick costs: the command passes),
+  called as ``Controller.command`` calls it, with the window's sample counts
+  ``NV, NW`` given (an omitted default argument sends every call through
+  numba's slow dispatch);
 * ``shield (adversarial)``: the same on full speed at a random yaw rate, so the
   window search runs whenever that command has no clear stop;
 * ``straight-stop check``: the previous conversion's admissibility test of one
@@ -36,7 +39,7 @@ import numpy as np
 
 from pathfuse.costmap import NO_DISCS, costmap_for
 from pathfuse.planners.drive import admissible
-from pathfuse.shield import CODE_NAMES, shield_unicycle, warmup_shield
+from pathfuse.shield import CODE_NAMES, NV, NW, shield_unicycle, warmup_shield
 from pathfuse.studies.barn import BarnConfig, _scenario, find_worlds, jackal_robot
 from pathfuse.world import load_scenario, simulate
 
@@ -73,7 +76,7 @@ def main() -> None:
     w0 = time.perf_counter()
     for sc, p, th, prev, cmd in data:
         g = sc.grid
-        rb = sc.robot.to_model()
+        rb = sc.robot
         cm = costmap_for(g, rb.radius_m)
         clear = cm.clear_m
         lim = (rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2, rb.max_yaw_rate_radps,
@@ -85,7 +88,7 @@ def main() -> None:
                 t0 = time.perf_counter()
                 out = shield_unicycle(cm, float(p[0]), float(p[1]), th,
                                       float(prev[0]), float(prev[1]), float(v), float(w),
-                                      float(sc.dt), *lim, NO_DISCS, 0.0)
+                                      float(sc.dt), *lim, NO_DISCS, 0.0, NV, NW)
                 best = min(best, time.perf_counter() - t0)
             rows[name].append(best)
             if name == "shield (adversarial)":

@@ -19,9 +19,10 @@ from numba import njit
 
 from pathfuse.costmap import Discs, segment_distance
 from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.planners.controllers.dwa_checks import _segment_distance, _sweep_gap
 from pathfuse.planners.controllers.social import EVERY_DISC, dwell_shortfall
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
-from pathfuse.sweep import arc_deviation_bound, disc_sweep_gaps, unicycle_pose
+from pathfuse.sweep import arc_deviation_bound, unicycle_pose
 
 __all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "relaxed", "dwa_tick",
            "keep_reference", "route_tangent", "DwaSettings", "DwaTick"]
@@ -230,10 +231,11 @@ def path_gap(cm, s, pts, cum, k, length):
 
 @njit(cache=True)
 def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
-             ty, dside, sides):
+             ty, dside, sides, reach):
     """Score one sample: ``out = [cost, admissible, first_tick_clear]``; ``sides[j] = (side,
     least predicted gap)`` of the sample against sensed disc ``j`` (the social critics,
-    :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction)."""
+    :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction);
+    ``reach`` is scratch space of one float per disc (allocated once per tick)."""
     res = cm.res_m
     dt = f.dt_s
     radius = cm.radius_m
@@ -259,12 +261,6 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
     travelled = 0.0
     n_disc = drad.shape[0]
     dyn = 0.0
-    qa = np.empty((1, 2))
-    qb = np.empty((1, 2))
-    rr = np.empty(1)
-    pa = np.empty(2)
-    pb = np.empty(2)
-    reach = np.empty(n_disc)
     stop_s = dt + (speed / amax if math.isfinite(amax) and amax > 0.0 else 0.0)
     if not f.passive:
         stop_s = 0.0
@@ -290,14 +286,14 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
     for i in range(1, n + 1):
         t = min(i * h, horizon)
         bx, by, bth = unicycle_pose(x, y, th, v, w, t)
-        d = segment_distance(cm, ax, ay, bx, by, cap, slack) - e
+        d = _segment_distance(cm, ax, ay, bx, by, cap, slack) - e
         if t <= dt + 1e-12:
             # the tick itself: the arc (lower bound) and the chord (the path offline) clear
             if d < clear:
                 first_ok = False
                 ok = False
                 break
-            if e > 0.0 and segment_distance(cm, ax, ay, bx, by, clear, slack) < clear:
+            if e > 0.0 and _segment_distance(cm, ax, ay, bx, by, clear, slack) < clear:
                 first_ok = False
                 ok = False
                 break
@@ -316,24 +312,19 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
             if pdi < np.inf:
                 align += pdi
                 n_align += 1
+        t0 = t - h if t - h > 0.0 else 0.0
         for j in range(n_disc):
-            pa[0] = ax
-            pa[1] = ay
-            pb[0] = bx
-            pb[1] = by
-            t0 = t - h if t - h > 0.0 else 0.0
-            qa[0, 0] = dpos[j, 0] + dvel[j, 0] * t0
-            qa[0, 1] = dpos[j, 1] + dvel[j, 1] * t0
-            qb[0, 0] = dpos[j, 0] + dvel[j, 0] * t
-            qb[0, 1] = dpos[j, 1] + dvel[j, 1] * t
-            rr[0] = drad[j]
+            qax = dpos[j, 0] + dvel[j, 0] * t0
+            qay = dpos[j, 1] + dvel[j, 1] * t0
+            qbx = dpos[j, 0] + dvel[j, 0] * t
+            qby = dpos[j, 1] + dvel[j, 1] * t
             # less how far the disc can come while the robot stops from here (so a pass
             # that the shield's passive-safety test would refuse counts as a collision)
-            g0 = disc_sweep_gaps(pa, pb, radius, qa, qb, rr)[0] - e
+            g0 = _sweep_gap(ax, ay, bx, by, radius, qax, qay, qbx, qby, drad[j]) - e
             if g0 < sides[j, 1]:
                 # the side of the route the disc is on at the closest approach so far
-                mx = 0.5 * (qa[0, 0] + qb[0, 0]) - 0.5 * (ax + bx)
-                my = 0.5 * (qa[0, 1] + qb[0, 1]) - 0.5 * (ay + by)
+                mx = 0.5 * (qax + qbx) - 0.5 * (ax + bx)
+                my = 0.5 * (qay + qby) - 0.5 * (ay + by)
                 # (the disc's signed offset from the robot across the route; a pass only
                 # where the two are side by side, not one behind the other)
                 cr = tx * my - ty * mx
@@ -503,6 +494,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
     discs = Discs(dpos, dvel, dspeed, drad)
     nd = drad.shape[0]
     sides = np.zeros((nd, 2))
+    reach = np.empty(nd)  # _rollout's scratch (one allocation per tick, not per sample)
     for j in range(nd):
         chosen[j, 0] = 0.0
         chosen[j, 1] = np.inf
@@ -535,7 +527,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                 sp = math.hypot(ux, uy)
                 hd = math.atan2(uy, ux) if sp > 0.0 else th
                 _rollout(cm, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg,
-                         dpos, dvel, drad, out, tx, ty, dside, sides)
+                         dpos, dvel, drad, out, tx, ty, dside, sides, reach)
                 if out[1] == 1.0 and n_disc > 0:
                     out[0] += _passive_penalty(holonomic_stop_disc_gap(
                         x, y, ux, uy, dt, amax, cm.radius_m, discs))
@@ -566,7 +558,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
             else:
                 w = min(max(0.0, wlo), whi)  # always try going straight
             _rollout(cm, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, dpos, dvel,
-                     drad, out, tx, ty, dside, sides)
+                     drad, out, tx, ty, dside, sides, reach)
             if out[1] == 1.0 and n_disc > 0:
                 out[0] += _passive_penalty(unicycle_stop_disc_gap(
                     x, y, th, v, w, dt, amax, f.max_yaw_accel_radps2, cm.radius_m, discs))

@@ -347,6 +347,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 def cmd_dynamic(args: argparse.Namespace) -> int:
     from pathfuse.studies.dynamic import (
         DynamicConfig,
+        headline,
         run_dynamic,
         success_pivot,
         summary_rows,
@@ -361,10 +362,7 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
     run = run_dynamic(cfg, progress=False if args.quiet else None, workers=args.workers,
                       db_path=_study_db(args.out))
     files = write_dynamic_outputs(run, args.out)
-    print(f"{len(run.records)} episodes ({len(cfg.planners)} planners x {len(cfg.moving)} disc "
-          f"counts x {cfg.n_seeds} scenarios) in {run.wall_s:.2f} s "
-          f"({run.episodes_per_s:.1f} episodes/s, {run.workers} worker"
-          f"{'s' if run.workers != 1 else ''})")
+    print(headline(run))
     rows = summary_rows(run)
     for title, key in (("success rate [95% CI]", "reached"),
                        ("collision rate [95% CI]", "collision")):

@@ -603,7 +603,8 @@ def test_the_sweep_summary_counts_runs_in_words():
 
 def test_the_study_summaries_count_in_words():
     """A one-episode dynamic run says "1 episode (1 planner x 1 disc count x 1 scenario)"."""
-    from pathfuse.studies.dynamic import DynamicConfig, DynamicRun, headline
+    from pathfuse.cli.commands import dynamic_headline as headline
+    from pathfuse.studies.dynamic import DynamicConfig, DynamicRun
 
     cfg = DynamicConfig(n_seeds=1, moving=(0,), planners=("fusion",))
     one = headline(DynamicRun(cfg, [{}], 2.0, workers=1))

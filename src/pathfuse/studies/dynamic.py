@@ -230,20 +230,6 @@ class DynamicRun:
         return len(self.records) / max(self.wall_s, 1e-9)
 
 
-def headline(run: DynamicRun) -> str:
-    """What ran and how fast, counted in words (``pathfuse dynamic`` prints it).
-
-    >>> cfg = DynamicConfig(n_seeds=1, moving=(0,), planners=("fusion",))
-    >>> headline(DynamicRun(cfg, [{}], 2.0))
-    '1 episode (1 planner x 1 disc count x 1 scenario) in 2.00 s (0.5 episodes/s, 1 worker)'
-    """
-    cfg = run.config
-    return (f"{counted(len(run.records), 'episode')} ({counted(len(cfg.planners), 'planner')} "
-            f"x {counted(len(cfg.moving), 'disc count')} x "
-            f"{counted(cfg.n_seeds, 'scenario')}) in {run.wall_s:.2f} s "
-            f"({run.episodes_per_s:.1f} episodes/s, {counted(run.workers, 'worker')})")
-
-
 def dynamic_experiment(config: DynamicConfig | None = None,
                        base_dir: str | os.PathLike[str] = ".") -> Any:
     """The experiment of the study engine that the benchmark runs.
@@ -517,7 +503,8 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
         f"discs of radius 0.2-0.4 m at {lo:g}-{hi:g} m/s aimed across the route, "
         "dt 0.1 s, time limit 60 s.  Planner parameters: "
         f"{params}.\n\n"
-        f"{headline(run)}.\n\n"
+        f"{counted(len(run.records), 'episode')} in {run.wall_s:.2f} s "
+        f"({run.episodes_per_s:.1f} episodes/s, {counted(run.workers, 'worker')}).\n\n"
         "## Success rate [95% Wilson CI]\n\n"
         f"{markdown_table(success_pivot(rows))}\n\n"
         f"## Social success: reached, never within {SOCIAL_GAP_M:g} m of a disc "

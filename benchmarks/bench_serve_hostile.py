@@ -46,7 +46,7 @@ from pathlib import Path
 TICK = os.sysconf("SC_CLK_TCK")
 SHORT = {"map": "paper", "planner": "astar"}
 SLOW = {"map": "paper", "planner": "dwa",
-        "params": {"v_samples": 64, "w_samples": 128, "horizon_s": 10, "sim_step_s": 0.01}}
+        "params": {"v_samples": 64, "w_samples": 128, "horizon_s": 2.4, "sim_step_s": 0.02}}
 
 
 def load() -> str:

@@ -599,3 +599,18 @@ def test_the_sweep_summary_counts_runs_in_words():
     done = str(SweepSummary("tiny", "t.db", total=1, skipped=1))
     assert "nothing to run, its one run is already stored in t.db" in done
     assert "summarises it)" in done
+
+
+def test_the_study_summaries_count_in_words():
+    """A one-episode dynamic run says "1 episode (1 planner x 1 disc count x 1 scenario)"."""
+    from pathfuse.cli.commands import dynamic_headline as headline
+    from pathfuse.studies.dynamic import DynamicConfig, DynamicRun
+
+    cfg = DynamicConfig(n_seeds=1, moving=(0,), planners=("fusion",))
+    one = headline(DynamicRun(cfg, [{}], 2.0, workers=1))
+    assert one.startswith("1 episode (1 planner x 1 disc count x 1 scenario) in 2.00 s")
+    assert one.endswith(", 1 worker)")
+    cfg = DynamicConfig(n_seeds=3, moving=(0, 2), planners=("fusion", "dwa"))
+    many = headline(DynamicRun(cfg, [{}] * 12, 2.0, workers=2))
+    assert many.startswith("12 episodes (2 planners x 2 disc counts x 3 scenarios)")
+    assert many.endswith(", 2 workers)")

@@ -52,9 +52,10 @@ from pathfuse.web.maps import Limits
 BASE = "http://127.0.0.1"
 DATA = Path(__file__).parent / "data"
 WORLD = DATA / "gazebo" / "known_cells.world"
-# DWA with the heaviest samples its bounds allow: seconds per tick
+# DWA with the heaviest tick its bounds allow (64 x 128 x 120 of dwa.TICK_PIECES' 1,000,000
+# rollout pieces): tenths of a second per tick, a few hundred ticks on the paper map
 SLOW_DWA = {"map": "paper", "planner": "dwa",
-            "params": {"v_samples": 64, "w_samples": 128, "horizon_s": 10, "sim_step_s": 0.01}}
+            "params": {"v_samples": 64, "w_samples": 128, "horizon_s": 2.4, "sim_step_s": 0.02}}
 
 
 def _client(**kw):
@@ -348,6 +349,18 @@ def test_the_dwa_request_of_the_issue_is_refused_at_once():
         r = c.post("/api/plan", json=body)
         assert r.status_code == 400 and time.monotonic() - t0 < 5
         assert r.json()["error"] == "dwa.v_samples: must be an integer >= 2 and <= 64, got 250"
+
+
+def test_a_dwa_tick_heavier_than_its_budget_is_refused_at_once():
+    # every key within its bound, the product 64 x 128 x 1000 rollout pieces a tick is not
+    body = {"map": "paper", "planner": "dwa",
+            "params": {"v_samples": 64, "w_samples": 128, "horizon_s": 10, "sim_step_s": 0.01}}
+    with _client() as c:
+        r = c.post("/api/plan", json=body)
+        assert r.status_code == 400
+        assert r.json()["error"] == (
+            "dwa.v_samples x w_samples x horizon_s / sim_step_s: must be at most 1000000 "
+            "rollout pieces a tick, got 64 x 128 x 1000 = 8192000")
 
 
 def test_planners_lists_the_bounds(capsys):

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["mean_ci", "bootstrap_mean_ci", "wilson_ci", "markdown_table", "write_csv"]
+__all__ = ["mean_ci", "bootstrap_mean_ci", "wilson_ci", "markdown_table", "write_csv", "counted"]
 
 
 def mean_ci(values: Sequence[float], level: float = 0.95) -> tuple[float, float, float]:
@@ -129,3 +129,12 @@ def write_csv(path: str | Path, rows: Sequence[dict[str, Any]] | Sequence[Sequen
             w.writerows(rows)  # type: ignore[arg-type]
         else:
             csv.writer(fh).writerows(rows)  # type: ignore[arg-type]
+
+
+def counted(n: int, noun: str, plural: str | None = None) -> str:
+    """``n`` and ``noun``, plural (``plural``, default ``noun + "s"``) unless ``n`` is 1.
+
+    >>> counted(1, "run"), counted(0, "run"), counted(3, "episode"), counted(1, "disc count")
+    ('1 run', '0 runs', '3 episodes', '1 disc count')
+    """
+    return f"{n} {noun if n == 1 else (plural or noun + 's')}"

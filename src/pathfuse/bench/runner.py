@@ -49,6 +49,7 @@ from pathfuse.bench.progress import ProgressBar, progress_enabled
 from pathfuse.bench.store import ResultStore
 from pathfuse.bench.warmup import warm_kernels
 from pathfuse.result import ConfigError
+from pathfuse.stats import counted
 
 __all__ = ["run_bench", "run_experiment", "SweepSummary", "SweepInterrupted", "StudyLocked",
            "ClusterLost",
@@ -97,7 +98,7 @@ class SweepSummary:
         return d
 
     def __str__(self) -> str:
-        where = self.scheduler or (f"{self.workers} worker" + ("s" if self.workers > 1 else ""))
+        where = self.scheduler or counted(self.workers, "worker")
         stored = self.skipped + self.ran
         if self.ran == 0 and self.complete and not self.interrupted:
             errs = (f"; {self.stored_errors} of them raised (ERROR), --retry-errors runs "
@@ -108,10 +109,10 @@ class SweepSummary:
                     f"{'them' if self.total != 1 else 'it'}){errs}")
         comp = f", {self.compile_s:.1f} s of it compiling kernels" \
             if self.compile_s >= 1.0 else ""
-        head = (f"{self.experiment}: {_count(self.ran, 'run')} in {self.wall_s:.1f} s "
+        head = (f"{self.experiment}: {counted(self.ran, 'run')} in {self.wall_s:.1f} s "
                 f"({self.runs_per_s:.1f} runs/s, {where}{comp}); {self.skipped} already stored; "
                 f"{stored}/{self.total} in {self.db_path}")
-        tail = (f"\n  of the {_count(self.ran, 'run')} now: solved {self.succeeded}, not solved "
+        tail = (f"\n  of the {counted(self.ran, 'run')} now: solved {self.succeeded}, not solved "
                 f"{self.failed}, errors {self.errors}")
         if self.crashed:
             tail += f" ({self.crashed} crashed their worker)"
@@ -120,15 +121,6 @@ class SweepSummary:
         for e in self.error_samples:
             tail += f"\n  error: {e}"
         return head + tail
-
-
-def _count(n: int, noun: str) -> str:
-    """``n`` and ``noun``, plural unless ``n`` is 1.
-
-    >>> _count(1, "run"), _count(0, "run"), _count(3, "run")
-    ('1 run', '0 runs', '3 runs')
-    """
-    return f"{n} {noun}{'' if n == 1 else 's'}"
 
 
 class SweepInterrupted(KeyboardInterrupt):

@@ -143,11 +143,11 @@ def cmd_barn(args: argparse.Namespace) -> int:
         for path in files.values():
             print(f"wrote {path}", file=sys.stderr)
         return 0
-    def n(k: int, what: str) -> str:
-        return f"{k} {what}{'' if k == 1 else 's'}"
+    from pathfuse.stats import counted
 
-    print(f"{n(len(run.records), 'episode')} ({n(len(cfg.planners), 'planner')} x "
-          f"{n(len(run.worlds), 'world')}) in {run.wall_s:.1f} s ({n(run.workers, 'worker')})\n")
+    print(f"{counted(len(run.records), 'episode')} ({counted(len(cfg.planners), 'planner')} x "
+          f"{counted(len(run.worlds), 'world')}) in {run.wall_s:.1f} s "
+          f"({counted(run.workers, 'worker')})\n")
     print(text_table(summary_rows(run.records, cfg.planners)))
     print("\nDWA (published): the challenge's baseline in Gazebo (move_base, 50 worlds x 10 "
           "runs), a reference line, not a like-for-like comparison.\n")

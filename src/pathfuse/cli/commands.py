@@ -344,6 +344,17 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     return 0 if ep.reached else EXIT_FAIL
 
 
+def dynamic_headline(run: Any) -> str:
+    """What ``pathfuse dynamic`` ran and how fast, counted in words."""
+    from pathfuse.stats import counted
+
+    c, n = run.config, len(run.records)
+    return (f"{counted(n, 'episode')} ({counted(len(c.planners), 'planner')} x "
+            f"{counted(len(c.moving), 'disc count')} x {counted(c.n_seeds, 'scenario')}) in "
+            f"{run.wall_s:.2f} s ({run.episodes_per_s:.1f} episodes/s, "
+            f"{counted(run.workers, 'worker')})")
+
+
 def cmd_dynamic(args: argparse.Namespace) -> int:
     from pathfuse.studies.dynamic import (
         DynamicConfig,
@@ -361,10 +372,7 @@ def cmd_dynamic(args: argparse.Namespace) -> int:
     run = run_dynamic(cfg, progress=False if args.quiet else None, workers=args.workers,
                       db_path=_study_db(args.out))
     files = write_dynamic_outputs(run, args.out)
-    print(f"{len(run.records)} episodes ({len(cfg.planners)} planners x {len(cfg.moving)} disc "
-          f"counts x {cfg.n_seeds} scenarios) in {run.wall_s:.2f} s "
-          f"({run.episodes_per_s:.1f} episodes/s, {run.workers} worker"
-          f"{'s' if run.workers != 1 else ''})")
+    print(dynamic_headline(run))
     rows = summary_rows(run)
     for title, key in (("success rate [95% CI]", "reached"),
                        ("collision rate [95% CI]", "collision")):

@@ -87,12 +87,11 @@ def cmd_irsim(args: argparse.Namespace) -> int:
                           progress=False if args.quiet else None)
     files = write_irsim_outputs(run, args.out)
 
-    def n(k: int, what: str) -> str:
-        return f"{k} {what}{'' if k == 1 else 's'}"
+    from pathfuse.stats import counted
 
-    print(f"{n(len(run.records), 'episode')} ({n(len(cfg.planners), 'planner')} x "
-          f"{n(len(cfg.worlds), 'world')} x {n(cfg.n_seeds, 'seed')}) in {run.wall_s:.1f} s "
-          f"({n(run.workers, 'worker')})\n")
+    print(f"{counted(len(run.records), 'episode')} ({counted(len(cfg.planners), 'planner')} x "
+          f"{counted(len(cfg.worlds), 'world')} x {counted(cfg.n_seeds, 'seed')}) in "
+          f"{run.wall_s:.1f} s ({counted(run.workers, 'worker')})\n")
     print(text_table(summary_rows(run.records, cfg.planners)))
     print()
     for path in files.values():

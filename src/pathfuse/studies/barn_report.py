@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.result import Status
-from pathfuse.stats import markdown_table, mean_ci, wilson_ci, write_csv
+from pathfuse.stats import counted, markdown_table, mean_ci, wilson_ci, write_csv
 
 __all__ = ["summary_rows", "markdown_report", "text_table", "write_barn_outputs",
            "OUTCOMES", "PERCENTILES", "fault_stats", "percentile_stats", "shield_stats",
@@ -247,11 +247,11 @@ def markdown_report(run: Any, rows: Sequence[Mapping[str, Any]] | None = None,
     idx = [w.index for w in run.worlds]
     return (
         "# BARN: the challenge's protocol on its Gazebo worlds\n\n"
-        f"{len(idx)} worlds ({_span(idx)}) from {cfg.directory}, rasterised at "
+        f"{counted(len(idx), 'world')} ({_span(idx)}) from {cfg.directory}, rasterised at "
         f"{cfg.resolution:g} m; start {BARN_START}, goal {BARN_GOAL} (reached within "
         f"{BARN_GOAL_TOLERANCE_M:g} m), {BARN_TIME_LIMIT_S:g} s limit; robot: {robot}; "
-        f"dt {cfg.dt:g} s.  {len(run.records)} episodes in {run.wall_s:.1f} s with "
-        f"{run.workers} worker{'s' if run.workers != 1 else ''}.\n\n"
+        f"dt {cfg.dt:g} s.  {counted(len(run.records), 'episode')} in {run.wall_s:.1f} s "
+        f"with {counted(run.workers, 'worker')}.\n\n"
         f"{markdown_table(_table(rows, DWA_BASELINE))}\n\n"
         "Rates carry 95% Wilson intervals and means 95% Student-t intervals (clipped to "
         "the values the quantity can take).  The metric "

@@ -47,7 +47,7 @@ import numpy as np
 
 from pathfuse.bench.summary import group_stats, value_stats
 from pathfuse.result import ConfigError, Status
-from pathfuse.stats import markdown_table, write_csv
+from pathfuse.stats import counted, markdown_table, write_csv
 from pathfuse.studies.barn_report import (
     SOCIAL_GAP_M,
     fault_cell,
@@ -503,9 +503,8 @@ def markdown_report(run: DynamicRun, rows: Sequence[Mapping[str, Any]] | None = 
         f"discs of radius 0.2-0.4 m at {lo:g}-{hi:g} m/s aimed across the route, "
         "dt 0.1 s, time limit 60 s.  Planner parameters: "
         f"{params}.\n\n"
-        f"{len(run.records)} episodes in {run.wall_s:.2f} s "
-        f"({run.episodes_per_s:.1f} episodes/s, {run.workers} worker"
-        f"{'s' if run.workers != 1 else ''}).\n\n"
+        f"{counted(len(run.records), 'episode')} in {run.wall_s:.2f} s "
+        f"({run.episodes_per_s:.1f} episodes/s, {counted(run.workers, 'worker')}).\n\n"
         "## Success rate [95% Wilson CI]\n\n"
         f"{markdown_table(success_pivot(rows))}\n\n"
         f"## Social success: reached, never within {SOCIAL_GAP_M:g} m of a disc "

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from pathfuse.result import ConfigError
+from pathfuse.stats import counted
 from pathfuse.validate import short as _shown
 
 __all__ = ["IrsimConfig", "IrsimRun", "irsim_experiment", "run_irsim_study",
@@ -370,9 +371,10 @@ def markdown_report(run: IrsimRun, rows: Sequence[Mapping[str, Any]] | None = No
     errors = sum(r["status"] == "ERROR" for r in run.records)
     return (
         "# Planners among people in IR-SIM\n\n"
-        f"{len(run.records)} episodes ({len(cfg.planners)} planners x {len(cfg.worlds)} worlds "
-        f"x {cfg.n_seeds} seeds) in {run.wall_s:.1f} s ({run.workers} worker"
-        f"{'s' if run.workers != 1 else ''}); {errors} ended in an error.  Static obstacles "
+        f"{counted(len(run.records), 'episode')} ({counted(len(cfg.planners), 'planner')} x "
+        f"{counted(len(cfg.worlds), 'world')} x {counted(cfg.n_seeds, 'seed')}) in "
+        f"{run.wall_s:.1f} s ({counted(run.workers, 'worker')}); {errors} ended in an error.  "
+        "Static obstacles "
         f"rasterised at {cfg.resolution_m:g} m.  `irsim-rvo` is IR-SIM's own robot driven by "
         "its RVO behaviour.\n\n"
         f"{worlds}\n\n"

@@ -10,6 +10,7 @@ import numpy as np
 from pathfuse.bench.summary import group_stats, median, value_stats
 from pathfuse.generate import PAPER_GOAL, PAPER_START
 from pathfuse.metrics import r_ratio
+from pathfuse.stats import counted
 from pathfuse.stats import markdown_table as _md
 from pathfuse.stats import write_csv as _write_csv
 from pathfuse.studies.paper_config import PAPER_LABELS, PAPER_PLANNERS, PAPER_TABLE, PaperRun
@@ -235,7 +236,7 @@ def _stats_tables(run: PaperRun, rows: list[dict[str, Any]], variant: str) -> st
             "-" if by[k]["is_fusion"] else _pct(by[k]["r_time_median"]) for k in names],
     ]
     return (
-        f"### Table I over {n} maps (seeds {cfg.first_seed}.."
+        f"### Table I over {counted(n, 'map')} (seeds {cfg.first_seed}.."
         f"{cfg.first_seed + n - 1}), {variant} variant: path length\n\n"
         f"{_VARIANT_TEXT.get(variant, variant)}.\n\n{_md(t1)}\n\n"
         "Length statistics are over each planner's successful runs; R_length pairs only maps "
@@ -243,7 +244,8 @@ def _stats_tables(run: PaperRun, rows: list[dict[str, Any]], variant: str) -> st
         "R < 0 means the fusion path is shorter (paper eq. 10). The excess over the shortest "
         "path, (L - L_shortest) / L_shortest, pairs each planner with the true shortest path "
         "on the maps where both succeeded.\n\n"
-        f"### Table II over {n} maps, {variant} variant: processing time\n\n{_md(t2)}\n\n"
+        f"### Table II over {counted(n, 'map')}, {variant} variant: processing time\n\n"
+        f"{_md(t2)}\n\n"
         "Times are wall-clock planning times in this process (A* included for the planners "
         "that use it; numba compilation excluded by a warm-up call before timing).  The "
         "interval of a mean time is a 95% percentile bootstrap (2000 resamples, seed 0), which "
@@ -280,11 +282,11 @@ def write_paper_outputs(run: PaperRun, out_dir: str | Path) -> dict[str, Path]:
     stats = "\n".join(_stats_tables(run, rows, v) for v in cfg.variants)
     text = (
         "# Reproduction of Ju, Luo and Yan, Tables I and II\n\n"
-        f"{cfg.n_seeds} paper-setup maps (15 m x 15 m, 1 m cells, start {PAPER_START}, "
+        f"{counted(cfg.n_seeds, 'paper-setup map')} (15 m x 15 m, 1 m cells, start {PAPER_START}, "
         f"goal {PAPER_GOAL}, 50 random obstacle cells), K_att {cfg.k_att:g}, "
         f"K_rep {cfg.k_rep:g}, rho_0 {cfg.rho0_m:g} m, "
         f"one step of {cfg.step_m:g} m for every stepping planner, the A* reference {rule}; "
-        f"{len(run.records)} runs in {run.wall_s:.2f} s "
+        f"{counted(len(run.records), 'run')} in {run.wall_s:.2f} s "
         f"({len(run.records) / max(run.wall_s, 1e-9):.0f} runs/s).\n\n"
         f"## The paper's values (one unpublished map)\n\n{paper_md}\n\n"
         f"## One map\n\n{one_md}\n## All maps\n\n{stats}"

@@ -100,7 +100,7 @@ from pathfuse.planners.controllers.social import PassingSides, disc_ids
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, SocialParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
-from pathfuse.result import Status
+from pathfuse.result import ConfigError, Status
 from pathfuse.robot import RobotModel
 from pathfuse.sweep import unicycle_pose
 from pathfuse.validate import param
@@ -161,6 +161,43 @@ class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
     stall_distance_m: float = param(0.05, gt=0, unit="m",
                                     help="offline: a net move below this over stall_steps "
                                          "ticks is a stall")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_tick_work(self.v_samples, self.w_samples, self.horizon_s, self.sim_step_s)
+
+
+TICK_PIECES = 1_000_000
+"""The most rollout pieces one DWA tick may compute: ``v_samples x w_samples x
+ceil(horizon_s / sim_step_s)`` (a holonomic robot rolls out 3 x as many, see ``w_samples``).
+
+Each bound of :data:`~pathfuse.planners.params.BOUNDS` alone allows 64 x 128 x 10,000
+pieces; a ``time_limit`` is checked between ticks, so such a tick could not honour it.
+Measured with ``plan()`` on an 8 x 5 map (x86_64, 2 shared cores, load 4-8, CPU time): a
+diff-drive tick at 64 x 128 x 1000 pieces took 1.19 s (so about 12 s at 10,000); at this
+budget (64 x 128 x 122) a diff-drive tick took 0.19 s and a holonomic one 0.36 s, and a
+``time_limit`` of 1 s ended the plan after 1.2 and 1.4 s of wall time.
+The defaults use 7 x 15 x 25 = 2,625."""
+
+
+def check_tick_work(v_samples: int, w_samples: int, horizon_s: float,
+                    sim_step_s: float) -> None:
+    """Refuse a DWA sampling whose one tick would roll out more than :data:`TICK_PIECES`.
+
+    >>> check_tick_work(64, 128, 2.5, 0.1)
+    >>> try:
+    ...     check_tick_work(64, 128, 10, 0.001)
+    ... except ConfigError as exc:
+    ...     print(*str(exc).split(", "), sep="\\n")
+    v_samples x w_samples x horizon_s / sim_step_s: must be at most 1000000 rollout pieces a tick
+    got 64 x 128 x 10000 = 81920000
+    """
+    pieces = max(1, int(math.ceil(horizon_s / sim_step_s - 1e-9)))
+    work = v_samples * w_samples * pieces
+    if work > TICK_PIECES:
+        raise ConfigError(f"v_samples x w_samples x horizon_s / sim_step_s: must be at most "
+                          f"{TICK_PIECES} rollout pieces a tick, got {v_samples} x "
+                          f"{w_samples} x {pieces} = {work}")
 
 
 def _offline_robot(problem: Problem) -> RobotModel:
@@ -316,7 +353,7 @@ class DWAController(Controller):
             if ticks >= max_ticks:
                 msg = f"tick cap of {max_ticks} ticks reached {self._where(x, y)}"
                 break
-            if deadline is not None and ticks % 64 == 0 and time.perf_counter() > deadline:
+            if deadline is not None and time.perf_counter() > deadline:  # every tick
                 status = Status.TIMEOUT
                 msg = f"time limit reached after {ticks} ticks, {self._where(x, y)}"
                 break

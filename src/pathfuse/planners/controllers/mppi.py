@@ -402,7 +402,7 @@ class MPPIController(Controller):
             if ticks >= max_ticks:
                 msg = f"tick cap of {max_ticks} ticks reached {self._where(x, y)}"
                 break
-            if deadline is not None and ticks % 16 == 0 and time.perf_counter() > deadline:
+            if deadline is not None and time.perf_counter() > deadline:  # every tick
                 status = Status.TIMEOUT
                 msg = f"time limit reached after {ticks} ticks, {self._where(x, y)}"
                 break

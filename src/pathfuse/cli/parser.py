@@ -48,6 +48,24 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"pathfuse {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
+    _add_plan(sub)
+    _add_scen(sub)
+    _add_paper(sub)
+    _add_simulate(sub)
+    _add_dynamic(sub)
+    add_barn_parser(sub)
+    add_irsim_parser(sub)
+    add_examples_parser(sub)
+    add_data_parser(sub)
+    _add_bench(sub)
+    _add_report(sub)
+    _add_planners(sub)
+    _add_serve(sub)
+    return parser
+
+
+def _add_plan(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse plan``: plan one path."""
     p = sub.add_parser(
         "plan",
         help="plan one path on a map and print (or plot) the result",
@@ -89,6 +107,9 @@ a ROS map_server .yaml, an inline-rows .yaml, or a .png/.pgm/.npy (with --resolu
     p.add_argument("--plot", metavar="OUT.png", help="write a PNG figure of the plan")
     p.set_defaults(func=cmd_plan)
 
+
+def _add_scen(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse scen``: check A* against a scenario file."""
     s = sub.add_parser(
         "scen",
         help="check A* against a MovingAI scenario file's optimal lengths",
@@ -114,6 +135,9 @@ examples:
                    "few plain lines otherwise)")
     s.set_defaults(func=cmd_scen)
 
+
+def _add_paper(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse paper``: the paper's tables."""
     pp = sub.add_parser(
         "paper",
         help="reproduce the paper's Tables I and II and Fig. 3 over many seeded maps",
@@ -152,6 +176,9 @@ examples:
                     "few plain lines otherwise)")
     pp.set_defaults(func=cmd_paper)
 
+
+def _add_simulate(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse simulate``: one moving-obstacle episode."""
     sm = sub.add_parser(
         "simulate",
         help="run one episode of a moving-obstacle scenario (and animate it)",
@@ -204,6 +231,9 @@ an animation plays in real time unless that takes more than 150 frames, then fas
                     help="with --json: include the per-tick positions and the path")
     sm.set_defaults(func=cmd_simulate)
 
+
+def _add_dynamic(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse dynamic``: the moving-obstacle benchmark."""
     dy = sub.add_parser(
         "dynamic",
         help="benchmark the online planners among moving obstacles",
@@ -250,11 +280,9 @@ examples:
                     "few plain lines otherwise)")
     dy.set_defaults(func=cmd_dynamic)
 
-    add_barn_parser(sub)
-    add_irsim_parser(sub)
-    add_examples_parser(sub)
-    add_data_parser(sub)
 
+def _add_bench(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse bench``: a benchmark sweep."""
     b = sub.add_parser(
         "bench",
         help="run (or resume) a benchmark sweep into a study database",
@@ -303,6 +331,9 @@ See experiments/*.yaml for the file format (maps, seeds, planners, swept paramet
                    "few plain lines otherwise)")
     b.set_defaults(func=cmd_bench)
 
+
+def _add_report(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse report``: a study's tables and figures."""
     r = sub.add_parser(
         "report",
         help="tables and figures of a study database (Markdown, CSV, PNG, HTML)",
@@ -338,6 +369,9 @@ with one configuration; by default R_length is against the experiment's own refe
                    help="link the PNGs from report.html instead of embedding them")
     r.set_defaults(func=cmd_report)
 
+
+def _add_planners(sub: argparse._SubParsersAction) -> None:
+    """``pathfuse planners``: the registry's planners."""
     q = sub.add_parser(
         "planners", help="list the registered planners and their parameters",
         description="List every planner in the registry: its global planner and controller, "
@@ -352,9 +386,6 @@ with one configuration; by default R_length is against the experiment's own refe
                    help="explain every parameter: default, unit, accepted values, meaning")
     q.add_argument("--json", action="store_true", help="print JSON")
     q.set_defaults(func=cmd_planners)
-
-    _add_serve(sub)
-    return parser
 
 
 def _port(text: str) -> int:

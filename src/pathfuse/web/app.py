@@ -201,6 +201,10 @@ def run_job(store: MapStore, kind: str, args: tuple[Any, ...]
         return 413, _dumps({"error": "request: needs more memory than this server has"}), []
 
 
+# Long on purpose (~240 lines of code): the route handlers are closures over one app's map
+# store, worker pool and limits, so nothing is module-level state and two apps in one
+# process (the tests run several) stay apart; each handler is a few lines, the request
+# rules (body, JSON depth, Host and Origin, errors) are helpers of this module.
 def create_app(*, map_folders: list[tuple[str, Path]] | None = None, limits: Limits | None = None,
                workers: int = 3, warm: bool = False, max_queue: int = 32,
                allowed_hosts: Iterable[str] | None = None) -> Starlette:

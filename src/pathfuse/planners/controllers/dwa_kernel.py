@@ -229,6 +229,11 @@ def path_gap(cm, s, pts, cum, k, length):
     return best - radius
 
 
+# Long on purpose (~190 lines): one sampled command's rollout and all its critics in one
+# pass over the rollout's pieces, which share the piece's pose, static distance and disc
+# gaps (and the admissibility that ends the rollout early); split per critic, every piece
+# would be computed again for each of the v_samples x w_samples commands per tick.  The
+# geometry is in helpers (dwa_checks, _path_distance, dwell_shortfall).
 @njit(cache=True)
 def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
              ty, dside, sides, reach):

@@ -319,6 +319,11 @@ def _brake(seq, f, c0, c1):
         p1 = b
 
 
+# Long on purpose (~140 lines): every critic scores a sampled sequence in one pass over its
+# steps, sharing the step's pose, static gap, path progress and disc gaps; split into one
+# function per critic, each would walk the rollout again or pass those locals in and out,
+# for every one of batch_size sequences per tick.  The geometry is in helpers
+# (field_distance, segment_distance, _track, _point_at, dwell_shortfall).
 @njit(cache=True)
 def _score(seq, cm, f, thr, x, y, th, c0, c1, pts, cum, pexp, k0, goal_mode, dpos,
            dvel, drad, dsteady):

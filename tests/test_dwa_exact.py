@@ -42,6 +42,30 @@ def test_segment_distance_shortcut_is_exact() -> None:
     assert hits > 1000  # the shortcut's case (nothing within the cap) was exercised
 
 
+def test_segment_distance_under_a_smaller_cap_is_the_same_value() -> None:
+    # the rollouts search only as far as could still change their result (dwa_kernel
+    # _rollout): under a smaller cap the distance is the same bit for bit, or the cap
+    g = _map()
+    rng = np.random.default_rng(2)
+    below = 0
+    for radius in (0.1, 0.333):
+        cm = costmap_for(g, radius)
+        for _ in range(3000):
+            ax = rng.uniform(cm.ox_m, cm.xmax_m)
+            ay = rng.uniform(cm.oy_m, cm.ymax_m)
+            a = rng.uniform(0.0, 2.0 * np.pi)
+            length = float(rng.choice([0.0, 0.05, 0.2]))
+            bx, by = ax + length * np.cos(a), ay + length * np.sin(a)
+            slack = float(rng.choice([0.0, 1e-7]))
+            wide = float(rng.uniform(0.3, 1.0))
+            narrow = float(rng.uniform(0.0, wide))
+            r1 = _segment_distance(cm, ax, ay, bx, by, wide, slack)
+            r2 = _segment_distance(cm, ax, ay, bx, by, narrow, slack)
+            assert r2 == (r1 if r1 < narrow else narrow)
+            below += r1 < narrow
+    assert below > 500
+
+
 def test_sweep_gap_is_disc_sweep_gaps() -> None:
     rng = np.random.default_rng(1)
     for _ in range(2000):

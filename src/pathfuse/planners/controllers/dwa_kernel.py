@@ -272,7 +272,12 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel
     for i in range(1, n + 1):
         t = min(i * h, horizon)
         bx, by, bth = unicycle_pose(x, y, th, v, w, t)
-        d = _segment_distance(cm, ax, ay, bx, by, cap, slack) - e
+        # the search stops at the least distance that could still change something (the
+        # clearance, the least gap so far, the keep critic's): a square farther than that
+        # changes nothing, and a nearer one is found at the same distance, bit for bit
+        lo = max(clear, dmin, dnear if t <= near + 1e-12 else clear) + e
+        d = _segment_distance(cm, ax, ay, bx, by, min(cap, lo + 1e-12 * (1.0 + lo)),
+                              slack) - e
         if t <= dt + 1e-12:
             # the tick itself: the arc (lower bound) and the chord (the path offline) clear
             if d < clear:

@@ -6,7 +6,12 @@ import numpy as np
 
 from pathfuse.costmap import costmap_for, segment_distance
 from pathfuse.grid import GridMap
-from pathfuse.planners.controllers.dwa_checks import _segment_distance, _sweep_gap
+from pathfuse.planners.controllers.dwa_checks import (
+    _path_distance,
+    _segment_distance,
+    _sweep_gap,
+    path_blocks,
+)
 from pathfuse.sweep import disc_sweep_gaps
 
 
@@ -37,6 +42,30 @@ def test_segment_distance_shortcut_is_exact() -> None:
     assert hits > 1000  # the shortcut's case (nothing within the cap) was exercised
 
 
+def test_segment_distance_under_a_smaller_cap_is_the_same_value() -> None:
+    # the rollouts search only as far as could still change their result (dwa_kernel
+    # _rollout): under a smaller cap the distance is the same bit for bit, or the cap
+    g = _map()
+    rng = np.random.default_rng(2)
+    below = 0
+    for radius in (0.1, 0.333):
+        cm = costmap_for(g, radius)
+        for _ in range(3000):
+            ax = rng.uniform(cm.ox_m, cm.xmax_m)
+            ay = rng.uniform(cm.oy_m, cm.ymax_m)
+            a = rng.uniform(0.0, 2.0 * np.pi)
+            length = float(rng.choice([0.0, 0.05, 0.2]))
+            bx, by = ax + length * np.cos(a), ay + length * np.sin(a)
+            slack = float(rng.choice([0.0, 1e-7]))
+            wide = float(rng.uniform(0.3, 1.0))
+            narrow = float(rng.uniform(0.0, wide))
+            r1 = _segment_distance(cm, ax, ay, bx, by, wide, slack)
+            r2 = _segment_distance(cm, ax, ay, bx, by, narrow, slack)
+            assert r2 == (r1 if r1 < narrow else narrow)
+            below += r1 < narrow
+    assert below > 500
+
+
 def test_sweep_gap_is_disc_sweep_gaps() -> None:
     rng = np.random.default_rng(1)
     for _ in range(2000):
@@ -47,3 +76,44 @@ def test_sweep_gap_is_disc_sweep_gaps() -> None:
         want = disc_sweep_gaps(p0, p1, r, q0[None, :], q1[None, :], np.array([rq]))[0]
         got = _sweep_gap(p0[0], p0[1], p1[0], p1[1], r, q0[0], q0[1], q1[0], q1[1], rq)
         assert got == want
+
+
+def _scan(pts: np.ndarray, cum: np.ndarray, k: int, jg: int, x: float,
+          y: float) -> tuple[float, float]:
+    """Every segment ``k .. jg - 1`` in order, the first of least distance (the brute force
+    the blocks stand for)."""
+    m = pts.shape[0]
+    pd, s_at = np.inf, cum[m - 1]
+    for j in range(k, min(jg, m - 1)):
+        a, d = pts[j], pts[j + 1] - pts[j]
+        l2 = d[0] * d[0] + d[1] * d[1]
+        tt = min(max(((x - a[0]) * d[0] + (y - a[1]) * d[1]) / l2, 0.0), 1.0) if l2 > 0 else 0.0
+        dd = np.hypot(x - (a[0] + tt * d[0]), y - (a[1] + tt * d[1]))
+        if dd < pd:
+            pd, s_at = dd, cum[j] + tt * (cum[j + 1] - cum[j])
+    return float(pd), float(s_at)
+
+
+def test_path_distance_blocks_are_a_scan_of_every_segment() -> None:
+    # grid paths (axis and diagonal runs, repeated points, a path back over itself: ties)
+    # and random polylines; points on the path, beside it and far away
+    rng = np.random.default_rng(5)
+    for trial in range(300):
+        n = int(rng.integers(1, 120))
+        if trial % 3 == 0:
+            steps = rng.choice([-1, 0, 1], size=(n, 2)) * 0.05
+            pts = np.cumsum(np.vstack([[0.0, 0.0], steps]), axis=0)
+        elif trial % 3 == 1:
+            pts = np.cumsum(np.vstack([[0.0, 0.0], rng.normal(size=(n, 2))]), axis=0)
+        else:
+            half = np.linspace(0.0, 2.0, n // 2 + 2)
+            pts = np.column_stack([np.r_[half, half[::-1]], np.zeros(2 * half.size)])
+        cum = np.r_[0.0, np.cumsum(np.hypot(*np.diff(pts, axis=0).T))]
+        m = pts.shape[0]
+        k = int(rng.integers(0, m))
+        jg = int(rng.integers(k, m + 3))
+        bb = path_blocks(pts, k, jg)
+        for _ in range(20):
+            j = int(rng.integers(0, m))
+            x, y = pts[j] + rng.normal(scale=float(rng.choice([0.0, 0.03, 0.5, 5.0])), size=2)
+            assert _path_distance(pts, cum, k, jg, bb, x, y) == _scan(pts, cum, k, jg, x, y)

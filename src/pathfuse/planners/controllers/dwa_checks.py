@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from pathfuse.costmap import field_distance, segment_distance
 
-__all__ = ["_segment_distance", "_sweep_gap"]
+__all__ = ["BLOCK", "_path_distance", "_segment_distance", "_sweep_gap", "path_blocks"]
 
 
 @njit(cache=True, inline="always")
@@ -63,3 +64,98 @@ def _segment_distance(cm, ax, ay, bx, by, cap, slack):
         if de < best:
             best = de
     return best
+
+
+BLOCK = 4
+"""Path segments per block of :func:`path_blocks`."""
+
+
+@njit(cache=True)
+def path_blocks(pts, k, jg):
+    """The bounding boxes ``(xmin, ymin, xmax, ymax)`` of the path's segments ``k .. jg - 1``
+    in blocks of :data:`BLOCK` (block ``b`` holds segments ``k + BLOCK b`` on), which
+    :func:`_path_distance` skips when a box is farther than its best so far."""
+    end = min(jg, pts.shape[0] - 1)
+    nb = max(0, (end - k + BLOCK - 1) // BLOCK)
+    bb = np.empty((nb, 4))
+    for b in range(nb):
+        j0 = k + b * BLOCK
+        j1 = min(j0 + BLOCK, end)
+        x0 = pts[j0, 0]
+        x1 = x0
+        y0 = pts[j0, 1]
+        y1 = y0
+        for j in range(j0 + 1, j1 + 1):
+            x0 = min(x0, pts[j, 0])
+            x1 = max(x1, pts[j, 0])
+            y0 = min(y0, pts[j, 1])
+            y1 = max(y1, pts[j, 1])
+        bb[b, 0] = x0
+        bb[b, 1] = y0
+        bb[b, 2] = x1
+        bb[b, 3] = y1
+    return bb
+
+
+@njit(cache=True, inline="always")
+def _segment_point(pts, j, x, y):
+    """Distance from ``(x, y)`` to the path's segment ``j`` and the segment parameter of the
+    projection."""
+    ax0 = pts[j, 0]
+    ay0 = pts[j, 1]
+    vx = pts[j + 1, 0] - ax0
+    vy = pts[j + 1, 1] - ay0
+    l2 = vx * vx + vy * vy
+    tt = 0.0
+    if l2 > 0.0:
+        tt = min(max(((x - ax0) * vx + (y - ay0) * vy) / l2, 0.0), 1.0)
+    return math.hypot(x - (ax0 + tt * vx), y - (ay0 + tt * vy)), tt
+
+
+@njit(cache=True, inline="always")
+def _box_distance(bb, b, x, y):
+    ox = max(bb[b, 0] - x, 0.0, x - bb[b, 2])
+    oy = max(bb[b, 1] - y, 0.0, y - bb[b, 3])
+    return math.sqrt(ox * ox + oy * oy)
+
+
+@njit(cache=True, inline="always")
+def _path_distance(pts, cum, k, jg, bb, x, y):
+    """Distance from ``(x, y)`` to the path's segments ``k .. jg`` and the arc length of its
+    projection (``inf`` and the path's end when there is no segment): the first segment of
+    least distance, bit for bit as a scan of every segment in order.
+
+    With the blocks ``bb`` (:func:`path_blocks`) it first takes the least distance
+    ``bound`` over the segments of the block whose box is nearest, then scans in order,
+    skipping every block whose box is farther than ``bound`` (or the best so far) by more
+    than 1e-9 m: none of its segments can be the first of least distance."""
+    m = pts.shape[0]
+    end = min(jg, m - 1)
+    bound = np.inf
+    nb = bb.shape[0]
+    if nb > 1:
+        bn = 0
+        dn = np.inf
+        for b in range(nb):
+            db = _box_distance(bb, b, x, y)
+            if db < dn:
+                dn = db
+                bn = b
+        for j in range(k + bn * BLOCK, min(k + (bn + 1) * BLOCK, end)):
+            dd, _ = _segment_point(pts, j, x, y)
+            bound = min(bound, dd)
+    pd = np.inf
+    s_at = cum[m - 1]
+    j = k
+    while j < end:
+        b = (j - k) // BLOCK
+        if (j - k) % BLOCK == 0 and b < nb:
+            if _box_distance(bb, b, x, y) > min(pd, bound) + 1e-9:
+                j += BLOCK
+                continue
+        dd, tt = _segment_point(pts, j, x, y)
+        if dd < pd:
+            pd = dd
+            s_at = cum[j] + tt * (cum[j + 1] - cum[j])
+        j += 1
+    return pd, s_at

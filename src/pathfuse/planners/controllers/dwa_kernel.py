@@ -19,7 +19,12 @@ from numba import njit
 
 from pathfuse.costmap import Discs, segment_distance
 from pathfuse.geometry import MARGIN_FRAC
-from pathfuse.planners.controllers.dwa_checks import _segment_distance, _sweep_gap
+from pathfuse.planners.controllers.dwa_checks import (
+    _path_distance,
+    _segment_distance,
+    _sweep_gap,
+    path_blocks,
+)
 from pathfuse.planners.controllers.social import EVERY_DISC, dwell_shortfall
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
 from pathfuse.sweep import arc_deviation_bound, unicycle_pose
@@ -185,31 +190,6 @@ def _local_goal(pts, cum, k, look):
     return j
 
 
-@njit(cache=True, inline="always")
-def _path_distance(pts, cum, k, jg, x, y):
-    """Distance from ``(x, y)`` to the path's segments ``k .. jg`` and the arc length of its
-    projection (``inf`` and the path's end when there is no segment)."""
-    m = pts.shape[0]
-    pd = np.inf
-    s_at = cum[m - 1]
-    j = k
-    while j < m - 1 and j < jg:
-        ax0 = pts[j, 0]
-        ay0 = pts[j, 1]
-        vx = pts[j + 1, 0] - ax0
-        vy = pts[j + 1, 1] - ay0
-        l2 = vx * vx + vy * vy
-        tt = 0.0
-        if l2 > 0.0:
-            tt = min(max(((x - ax0) * vx + (y - ay0) * vy) / l2, 0.0), 1.0)
-        dd = math.hypot(x - (ax0 + tt * vx), y - (ay0 + tt * vy))
-        if dd < pd:
-            pd = dd
-            s_at = cum[j] + tt * (cum[j + 1] - cum[j])
-        j += 1
-    return pd, s_at
-
-
 @njit(cache=True)
 def path_gap(cm, s, pts, cum, k, length):
     """The least gap (distance less the robot's radius) of the path from ``pts[k]`` over
@@ -235,12 +215,13 @@ def path_gap(cm, s, pts, cum, k, length):
 # would be computed again for each of the v_samples x w_samples commands per tick.  The
 # geometry is in helpers (dwa_checks, _path_distance, dwell_shortfall).
 @njit(cache=True)
-def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
-             ty, dside, sides, reach):
+def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel, drad, out,
+             tx, ty, dside, sides, reach):
     """Score one sample: ``out = [cost, admissible, first_tick_clear]``; ``sides[j] = (side,
     least predicted gap)`` of the sample against sensed disc ``j`` (the social critics,
     :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction);
-    ``reach`` is scratch space of one float per disc (allocated once per tick)."""
+    ``reach`` is scratch space of one float per disc (allocated once per tick); ``bb`` the
+    path's segment blocks ``k .. jg`` (:func:`path_blocks`, once per tick)."""
     res = cm.res_m
     dt = f.dt_s
     radius = cm.radius_m
@@ -291,7 +272,12 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
     for i in range(1, n + 1):
         t = min(i * h, horizon)
         bx, by, bth = unicycle_pose(x, y, th, v, w, t)
-        d = _segment_distance(cm, ax, ay, bx, by, cap, slack) - e
+        # the search stops at the least distance that could still change something (the
+        # clearance, the least gap so far, the keep critic's): a square farther than that
+        # changes nothing, and a nearer one is found at the same distance, bit for bit
+        lo = max(clear, dmin, dnear if t <= near + 1e-12 else clear) + e
+        d = _segment_distance(cm, ax, ay, bx, by, min(cap, lo + 1e-12 * (1.0 + lo)),
+                              slack) - e
         if t <= dt + 1e-12:
             # the tick itself: the arc (lower bound) and the chord (the path offline) clear
             if d < clear:
@@ -313,7 +299,7 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
         if t <= near + 1e-12 and d < dnear:
             dnear = d
         if walign > 0.0:
-            pdi, _ = _path_distance(pts, cum, k, jg, bx, by)
+            pdi, _ = _path_distance(pts, cum, k, jg, bb, bx, by)
             if pdi < np.inf:
                 align += pdi
                 n_align += 1
@@ -388,7 +374,7 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
     # the end point against the path near the progress index: its distance to the path and
     # how much path is left beyond its projection
     m = pts.shape[0]
-    pd, s_end = _path_distance(pts, cum, k, jg, ex, ey)
+    pd, s_end = _path_distance(pts, cum, k, jg, bb, ex, ey)
     if pd == np.inf:
         pd = math.hypot(ex - pts[m - 1, 0], ey - pts[m - 1, 1])
         s_end = cum[m - 1]
@@ -487,6 +473,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
     nv = f.v_samples
     nw = f.w_samples
     jg = _local_goal(pts, cum, k, f.max_speed_mps * f.horizon_s + f.lookahead_m + 1.0)
+    bb = path_blocks(pts, k, jg)
     out = np.zeros(3)
     best = np.inf
     b0 = 0.0
@@ -531,7 +518,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                             uy *= vmax / sn * (1.0 - 1e-12)
                 sp = math.hypot(ux, uy)
                 hd = math.atan2(uy, ux) if sp > 0.0 else th
-                _rollout(cm, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg,
+                _rollout(cm, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg, bb,
                          dpos, dvel, drad, out, tx, ty, dside, sides, reach)
                 if out[1] == 1.0 and n_disc > 0:
                     out[0] += _passive_penalty(holonomic_stop_disc_gap(
@@ -562,7 +549,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                                                 whi)
             else:
                 w = min(max(0.0, wlo), whi)  # always try going straight
-            _rollout(cm, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, dpos, dvel,
+            _rollout(cm, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel,
                      drad, out, tx, ty, dside, sides, reach)
             if out[1] == 1.0 and n_disc > 0:
                 out[0] += _passive_penalty(unicycle_stop_disc_gap(

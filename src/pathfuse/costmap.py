@@ -69,7 +69,7 @@ __all__ = [
 _MAX_LATTICE_CELLS = 4_000_000
 _LATTICES: weakref.WeakKeyDictionary[GridMap, dict[float, tuple[np.ndarray, float]]] = \
     weakref.WeakKeyDictionary()
-_COSTMAPS: weakref.WeakKeyDictionary[GridMap, dict[tuple[float, float, float], Costmap]] = \
+_COSTMAPS: weakref.WeakKeyDictionary[GridMap, dict[tuple[float, float, bool], Costmap]] = \
     weakref.WeakKeyDictionary()
 
 
@@ -98,6 +98,8 @@ class Costmap(NamedTuple):
         The clearance lower bound on a lattice of cells of side ``field_res_m``:
         the distance from each lattice cell's centre to the nearest occupied
         square, less half a lattice cell's diagonal (``inf`` on a free map).
+        Built without it (``lattice=False``, for the field loops, which never
+        read it): one cell of ``-inf``, a lower bound that proves no clearance.
     field_res_m : float
         The lattice's cell side (the map's cell split ``s x s``, ``s`` from 1 to 8).
 
@@ -208,7 +210,7 @@ def clearance_lattice(grid: GridMap, cell_m: float) -> tuple[np.ndarray, float]:
 
 def make_costmap(occupied: Any, radius_m: float, *, origin: Any = None,
                  resolution_m: Any = None, clear_m: Any = None,
-                 field_cell_m: Any = None) -> Costmap:
+                 field_cell_m: Any = None, lattice: bool = True) -> Costmap:
     """The one constructor of a :class:`Costmap`: checks its inputs, builds the lattice.
 
     Parameters
@@ -227,6 +229,11 @@ def make_costmap(occupied: Any, radius_m: float, *, origin: Any = None,
         :data:`~pathfuse.geometry.MARGIN_FRAC` of a cell.
     field_cell_m : float, optional
         The lattice's cell side (> 0) wanted; default: the map's cells.
+    lattice : bool
+        False: no clearance lattice (no distance transform, no scipy import):
+        ``field`` is one cell of ``-inf`` (so :func:`field_distance` proves
+        nothing) and ``field_res_m`` the map's cell side.  For kernels that do
+        not read it (the field loops of :mod:`pathfuse.field.kernels`).
 
     Raises
     ------
@@ -240,6 +247,9 @@ def make_costmap(occupied: Any, radius_m: float, *, origin: Any = None,
     ...                   field_cell_m=0.05)
     >>> cm.field.shape, cm.field_res_m
     ((4, 4), 0.05)
+    >>> bare = make_costmap(np.zeros((2, 2), dtype=np.bool_), 0.25, lattice=False)
+    >>> bare.field.tolist(), bare.field_res_m
+    ([[-inf]], 1.0)
     >>> make_costmap(np.zeros((2, 2), dtype=np.bool_), 0.25, resolution_m=0)
     Traceback (most recent call last):
     ...
@@ -271,7 +281,10 @@ def make_costmap(occupied: Any, radius_m: float, *, origin: Any = None,
         occ = np.ascontiguousarray(occ).view()
         occ.setflags(write=False)
     h, w = occ.shape
-    if grid is not None:
+    if not lattice:
+        field, fres = np.full((1, 1), -np.inf), res
+        field.setflags(write=False)
+    elif grid is not None:
         field, fres = clearance_lattice(grid, cell)
     else:
         s = _split(res, (h, w), cell)
@@ -279,7 +292,8 @@ def make_costmap(occupied: Any, radius_m: float, *, origin: Any = None,
     return Costmap(occ, ox, oy, res, ox + w * res, oy + h * res, radius, clear, field, fres)
 
 
-def costmap_for(grid: GridMap, radius_m: float, field_cell_m: float | None = None) -> Costmap:
+def costmap_for(grid: GridMap, radius_m: float, field_cell_m: float | None = None,
+                lattice: bool = True) -> Costmap:
     """:func:`make_costmap` of a map, built once per map, radius and lattice (cached).
 
     Examples
@@ -288,11 +302,12 @@ def costmap_for(grid: GridMap, radius_m: float, field_cell_m: float | None = Non
     >>> costmap_for(g, 0.2) is costmap_for(g, 0.2)
     True
     """
-    key = (float(radius_m), -1.0 if field_cell_m is None else float(field_cell_m), 0.0)
+    key = (float(radius_m), -1.0 if field_cell_m is None else float(field_cell_m),
+           bool(lattice))
     per = _COSTMAPS.setdefault(grid, {})
     cm = per.get(key)
     if cm is None:
-        cm = make_costmap(grid, radius_m, field_cell_m=field_cell_m)
+        cm = make_costmap(grid, radius_m, field_cell_m=field_cell_m, lattice=lattice)
         per[key] = cm
     return cm
 

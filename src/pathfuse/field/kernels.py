@@ -21,13 +21,17 @@ controller makes and the way it drives are one code path.  An offline run
 passes :data:`STATIC` (``None`` for the discs): numba prunes every ``drad is
 None`` branch when it compiles that signature, so a static plan compiles no
 disc code (seconds on a cold cache) and computes what empty arrays give.  The
-last argument, ``margin``, is the soft safety margin (``f[F_MARGIN]``); a
-static run without one omits it (``None``), which prunes the margin's code
-the same way.
+last argument, ``margin``, is the soft safety margin (the settings'
+``margin_m``); a static run without one omits it (``None``), which prunes the
+margin's code the same way.
 
-Settings travel in small arrays (few arguments = little dispatch overhead),
-filled by :mod:`pathfuse.field.settings`; state that persists
-between calls lives in an ``int64`` array (``state``).
+The map, its frame, the robot's radius and the clearance it keeps come as one
+:class:`~pathfuse.costmap.Costmap` (``cm``, built without its lattice, which
+the loops do not read), the settings as named tuples read by name
+(:class:`~pathfuse.field.settings.FieldSettings` or
+:class:`~pathfuse.field.settings.FusionSettings`, ``s``, and the moving
+discs' :class:`~pathfuse.field.settings.DiscSettings`, ``ds``); state that
+persists between calls lives in an ``int64`` array (``state``).
 
 Codes: :data:`CODE_RUNNING` (``max_steps`` reached: call again),
 :data:`CODE_GOAL` (the robot stands on the goal), :data:`CODE_GOAL_SNAP`
@@ -38,12 +42,12 @@ the force), :data:`CODE_COLLISION` (``safe_step`` off: the full step along the
 force touched an obstacle; the step is in the path).  :func:`code_status`
 maps them to :class:`~pathfuse.result.Status`.
 
-The paper's rules (both loops): with ``I_SAFE`` = 0 the robot takes the full
+The paper's rules (both loops): with ``safe_step`` false the robot takes the full
 step along the force, as the paper's Algorithm 2 does, instead of the safe
 step (:func:`~pathfuse.field.motion.safe_step`: slide along the wall or
 shorten the step); a step that would touch an obstacle (for a disc robot:
 come closer than its radius, the rule of :mod:`pathfuse.metrics`) is taken and
-ends the run with :data:`CODE_COLLISION`.  With ``I_STALL`` = 0 there is no
+ends the run with :data:`CODE_COLLISION`.  With ``stall_exit`` false there is no
 stall test (the paper's loop ends only at the goal): the run ends at the goal,
 a block, a collision or the move cap.
 """
@@ -100,25 +104,6 @@ CODE_GOAL_SNAP = refined(CODE_SUCCESS)
 CODE_STALLED = CODE_LOCAL_MINIMUM
 CODE_BLOCKED = refined(CODE_LOCAL_MINIMUM)
 
-# --- float settings shared by both loops (slots 0..19)
-F_GX, F_GY, F_KATT, F_KREP, F_RHO0, F_STEP, F_TOL, F_CLEAR, F_STALLD, F_OX = range(10)
-F_OY, F_RES, F_RADIUS, F_KMOV, F_RHOMOV, F_REACH, F_AMAX, F_SWERVE, F_RVX, F_RVY = range(10, 20)
-# field_loop only
-F_SUBTOL, F_NEXP, F_SCALE = 20, 21, 22
-# fusion_loop only
-F_R1, F_R2, F_BACKOFF = 20, 21, 22
-# both: the soft safety margin (ours; 0 = off)
-F_MARGIN = 23
-# both: the offset of the boundary repulsion (ours)
-F_OFFSET = 24
-N_F = 25
-# --- int settings
-I_STALLN, I_VELAWARE = 0, 1
-I_IMPROVED, I_TOGOAL = 2, 3  # field_loop
-I_AHEAD, I_ESCAPE, I_ESC_PTS, I_DRIVE = 2, 3, 4, 5  # fusion_loop
-I_SAFE, I_STALL = 6, 7  # both: safe step (ours) or the paper's full step; stall test (ours)
-I_BOUNDARY = 8  # both: 1 = the boundary repulsion (ours), 0 = the paper's per-cell sum
-N_I = 9
 # --- state
 S_SUB = 0  # field_loop: current sub-goal index
 # fusion_loop: progress index, mode (0 Algorithm 2, 1 escape along path points,
@@ -145,14 +130,18 @@ def code_status(code: int, steps: int, max_steps: int) -> Status:
 
 # --------------------------------------------------------------------- shared pieces
 @njit(cache=True, inline="always")
-def _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear):
-    """Goal test: append the goal when within ``tol`` and the move onto it is clear."""
+def _goal_reached(buf, n, x, y, s, cm):
+    """Goal test: append the goal when within the goal tolerance and the move onto it is
+    clear."""
+    gx = s.goal_x_m
+    gy = s.goal_y_m
+    tol = s.goal_tolerance_m
     ex = x - gx
     ey = y - gy
     if ex * ex + ey * ey <= tol * tol:
         if x == gx and y == gy:
             return n, CODE_GOAL
-        if segment_is_clear(x, y, gx, gy, occ, ox, oy, res, clear):
+        if segment_is_clear(x, y, gx, gy, cm.occ, cm.ox_m, cm.oy_m, cm.res_m, cm.clear_m):
             buf[n, 0] = gx
             buf[n, 1] = gy
             return n + 1, CODE_GOAL_SNAP
@@ -160,7 +149,7 @@ def _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear):
 
 
 @njit(cache=True, inline="always")
-def _discs(x, y, fx, fy, f, i, dpos, dvel, drad):
+def _discs(x, y, fx, fy, cm, ds, dpos, dvel, drad):
     """The sensed discs' repulsion for a robot heading along ``(fx, fy)``."""
     if drad is None:  # a static run: no disc code is compiled
         return 0.0, 0.0
@@ -169,22 +158,29 @@ def _discs(x, y, fx, fy, f, i, dpos, dvel, drad):
     fn = math.hypot(fx, fy)
     ux = fx / fn if fn > 0.0 else 0.0
     uy = fy / fn if fn > 0.0 else 0.0
-    return disc_repulsion(x, y, f[F_RVX], f[F_RVY], f[F_RADIUS], dpos, dvel, drad, f[F_KMOV],
-                          f[F_RHOMOV], f[F_REACH], i[I_VELAWARE] == 1, f[F_AMAX], f[F_SWERVE],
-                          ux, uy)
+    return disc_repulsion(x, y, ds.robot_vx_mps, ds.robot_vy_mps, cm.radius_m, dpos, dvel,
+                          drad, ds.k_rep, ds.rho0_m, ds.reach_m, ds.velocity_aware,
+                          ds.a_max_mps2, ds.swerve, ux, uy)
 
 
 @njit(cache=True, inline="always")
-def _step(x, y, fx, fy, step, occ, ox, oy, res, clear, safe, radius, margin):
-    """One move: the safe step (``safe``; keeping the soft safety ``margin`` too, see
-    :func:`~pathfuse.field.motion.safe_step_margin`), or the paper's full step along the
-    force.
+def _step(x, y, fx, fy, s, cm, margin):
+    """One move of ``s.step_m``: the safe step (``s.safe_step``; keeping the soft safety
+    ``margin`` too, see :func:`~pathfuse.field.motion.safe_step_margin`), or the paper's
+    full step along the force.
 
     Returns ``(nx, ny, how)``; for the full step ``how`` is ``HOW_BLOCKED`` for a
     zero force, ``HOW_FULL`` for a step touching nothing and ``-1`` for a step
-    that touches an obstacle (closer than ``radius``; for a point any contact).
+    that touches an obstacle (closer than the robot's radius; for a point any contact).
     """
-    if safe:
+    step = s.step_m
+    occ = cm.occ
+    ox = cm.ox_m
+    oy = cm.oy_m
+    res = cm.res_m
+    clear = cm.clear_m
+    radius = cm.radius_m
+    if s.safe_step:
         if margin is None:  # no margin (pruned when compiled): the safe step itself
             return safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
         return safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, margin)
@@ -222,39 +218,38 @@ def _grow_int(kbuf, n):
 
 # --------------------------------------------------------------------- field loop
 @njit(cache=True)
-def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad, margin=None):
+def field_loop(buf, n, max_steps, cm, subs, state, s, ds, dpos, dvel, drad, margin=None):
     """APF steps through the sub-goals ``subs`` (K, 2), the last one the goal.
 
     The current sub-goal ``subs[state[S_SUB]]`` attracts (eq. 5); it is
     passed when the robot comes within the sub-goal tolerance.  Repulsion:
     eq. 6 from the cells within ``rho0`` (plain) or the Ge-Cui form towards
-    the sub-goal or the goal (``I_IMPROVED``, ``I_TOGOAL``), plus the sensed
-    discs.  The goal test runs before every step.  Returns ``(buf, n, code,
+    the sub-goal or the goal (``s.improved``, ``s.rep_to_goal``), plus the
+    sensed discs.  The goal test runs before every step.  ``cm`` is the
+    :class:`~pathfuse.costmap.Costmap`, ``s`` the
+    :class:`~pathfuse.field.settings.FieldSettings`, ``ds`` the
+    :class:`~pathfuse.field.settings.DiscSettings`.  Returns ``(buf, n, code,
     steps)``.
     """
-    gx = f[F_GX]
-    gy = f[F_GY]
-    k_att = f[F_KATT]
-    k_rep = f[F_KREP]
-    rho0 = f[F_RHO0]
-    step = f[F_STEP]
-    tol = f[F_TOL]
-    clear = f[F_CLEAR]
-    stall_d = f[F_STALLD]
-    ox = f[F_OX]
-    oy = f[F_OY]
-    res = f[F_RES]
-    sub_tol = f[F_SUBTOL]
-    nexp = f[F_NEXP]
-    scale = f[F_SCALE]
-    stall_n = i[I_STALLN]
-    safe = i[I_SAFE] == 1
-    stall = i[I_STALL] == 1
-    radius = f[F_RADIUS]
-    improved = i[I_IMPROVED] == 1
-    to_goal = i[I_TOGOAL] == 1
-    boundary = i[I_BOUNDARY] == 1
-    offset = f[F_OFFSET]
+    gx = s.goal_x_m
+    gy = s.goal_y_m
+    k_att = s.k_att
+    k_rep = s.k_rep
+    rho0 = s.rho0_m
+    stall_d = s.stall_distance_m
+    occ = cm.occ
+    ox = cm.ox_m
+    oy = cm.oy_m
+    res = cm.res_m
+    sub_tol = s.subgoal_tolerance_m
+    nexp = s.rep_exponent
+    scale = s.rep_scale_m
+    stall_n = s.stall_steps
+    stall = s.stall_exit
+    improved = s.improved
+    to_goal = s.rep_to_goal
+    boundary = s.boundary
+    offset = s.boundary_offset_m
     last = subs.shape[0] - 1
     j = state[S_SUB]
     x = buf[n - 1, 0]
@@ -268,7 +263,7 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad, marg
         if n + 2 > buf.shape[0]:
             buf = _grow(buf, n)
         if j == last:
-            n, done = _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear)
+            n, done = _goal_reached(buf, n, x, y, s, cm)
             if done != CODE_RUNNING:
                 code = done
                 break
@@ -287,9 +282,8 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad, marg
                                       offset)
         fx += rx
         fy += ry
-        dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
-        nx, ny, how = _step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear, safe,
-                            radius, margin)
+        dfx, dfy = _discs(x, y, fx, fy, cm, ds, dpos, dvel, drad)
+        nx, ny, how = _step(x, y, fx + dfx, fy + dfy, s, cm, margin)
         if how == HOW_BLOCKED:
             code = CODE_BLOCKED
             break
@@ -313,7 +307,7 @@ def field_loop(buf, n, max_steps, occ, subs, state, f, i, dpos, dvel, drad, marg
 
 # --------------------------------------------------------------------- fusion loop
 @njit(cache=True, inline="always")
-def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, drad):
+def _escape_move(x, y, tx, ty, s, cm, ds, dpos, dvel, drad):
     """One escape move towards ``(tx, ty)``: ``(nx, ny, moved, reached)``.
 
     Without a disc in reach: a straight move of at most one step, landing
@@ -322,21 +316,27 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
     the discs' repulsion, taken as a safe step; the target counts as reached
     within half a step.
     """
+    step = s.step_m
+    occ = cm.occ
+    ox = cm.ox_m
+    oy = cm.oy_m
+    res = cm.res_m
+    clear = cm.clear_m
     d = math.hypot(tx - x, ty - y)
     dfx = 0.0
     dfy = 0.0
     if drad is not None and drad.shape[0] > 0 and d > 0.0:
-        dfx, dfy = _discs(x, y, tx - x, ty - y, f, i, dpos, dvel, drad)
+        dfx, dfy = _discs(x, y, tx - x, ty - y, cm, ds, dpos, dvel, drad)
     if drad is None or (dfx == 0.0 and dfy == 0.0):  # a static run compiles this move only
         nx, ny, landed = straight_move(x, y, tx, ty, step)
         if segment_is_clear(x, y, nx, ny, occ, ox, oy, res, clear):
             return nx, ny, True, landed
         return x, y, False, False
-    pull = f[F_KATT] * f[F_R1] / d
+    pull = s.k_att * s.r1_m / d
     fx = pull * (tx - x) + dfx
     fy = pull * (ty - y) + dfy
-    nx, ny, how = safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, f[F_MARGIN])
-    if how == HOW_BLOCKED and f[F_MARGIN] > 0.0:  # the margin gives way to the escape
+    nx, ny, how = safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, s.margin_m)
+    if how == HOW_BLOCKED and s.margin_m > 0.0:  # the margin gives way to the escape
         nx, ny, how = safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
     if how == HOW_BLOCKED:
         return x, y, False, False
@@ -349,24 +349,27 @@ def _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy, res, clear, dpos, dvel, 
 # so split into calls every piece would pass that state in and out.  The force and the
 # step already are helpers (fusion_force, _step, _escape_move, _goal_reached).
 @njit(cache=True)
-def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel, drad,
+def fusion_loop(buf, kbuf, n, max_steps, cm, pts, cum, state, s, ds, dpos, dvel, drad,
                 margin=None):
     """Algorithm 2 steps from ``buf[n-1]`` along the global path ``pts`` (M, 2).
 
     ``pts`` ends at the goal, ``cum`` (M,) is its cumulative arc length,
     ``kbuf`` (as long as ``buf``) receives the progress index at each walked
-    point (``kbuf[0] = 0``).  Returns ``(buf, kbuf, n, code, steps)``.
+    point (``kbuf[0] = 0``).  ``cm`` is the :class:`~pathfuse.costmap.Costmap`,
+    ``s`` the :class:`~pathfuse.field.settings.FusionSettings`, ``ds`` the
+    :class:`~pathfuse.field.settings.DiscSettings`.  Returns ``(buf, kbuf, n,
+    code, steps)``.
 
     Mode 0 is Algorithm 2: the progress index moves on
     (:func:`~pathfuse.field.pathing.advance_progress`), the goal and the path
     points ahead within ``r1`` attract, the cells within ``r2`` and the
     sensed discs repel, one safe step.
 
-    Escape (``I_ESCAPE``): when the robot stalls or is blocked it picks a
+    Escape (``s.escape``): when the robot stalls or is blocked it picks a
     walked point and a path point to rejoin from
     (:func:`~pathfuse.field.pathing.find_rejoin`, with ``rvis = r1 + res``).
-    Planning (``I_DRIVE`` = 0) drops the walk after that point from the path
-    and continues from there; driving (``I_DRIVE`` = 1) walks back along its
+    Planning (``s.drive`` false) drops the walk after that point from the path
+    and continues from there; driving (``s.drive``) walks back along its
     own trail to it (mode 2).  Then the robot goes straight to the chosen path
     point and follows the path points one by one until it is
     ``escape_points`` past its progress at the stall (mode 1); then
@@ -375,31 +378,28 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
     turns ``4 M + 64`` times without moving ends as blocked (every loop
     ends).
     """
-    gx = f[F_GX]
-    gy = f[F_GY]
-    k_att = f[F_KATT]
-    k_rep = f[F_KREP]
-    rho0 = f[F_RHO0]
-    r1 = f[F_R1]
-    r2 = f[F_R2]
-    backoff_window = f[F_BACKOFF]
-    step = f[F_STEP]
-    tol = f[F_TOL]
-    clear = f[F_CLEAR]
-    stall_d = f[F_STALLD]
-    ox = f[F_OX]
-    oy = f[F_OY]
-    res = f[F_RES]
-    stall_n = i[I_STALLN]
-    ahead = i[I_AHEAD]
-    escape = i[I_ESCAPE]
-    esc_pts = i[I_ESC_PTS]
-    drive = i[I_DRIVE] == 1
-    safe = i[I_SAFE] == 1
-    stall = i[I_STALL] == 1
-    radius = f[F_RADIUS]
-    boundary = i[I_BOUNDARY] == 1
-    offset = f[F_OFFSET]
+    gx = s.goal_x_m
+    gy = s.goal_y_m
+    k_att = s.k_att
+    k_rep = s.k_rep
+    rho0 = s.rho0_m
+    r1 = s.r1_m
+    r2 = s.r2_m
+    backoff_window = s.backoff_window_m
+    stall_d = s.stall_distance_m
+    occ = cm.occ
+    ox = cm.ox_m
+    oy = cm.oy_m
+    res = cm.res_m
+    clear = cm.clear_m
+    stall_n = s.stall_steps
+    ahead = s.ahead
+    escape = s.escape
+    esc_pts = s.escape_points
+    drive = s.drive
+    stall = s.stall_exit
+    boundary = s.boundary
+    offset = s.boundary_offset_m
     m = pts.shape[0]
     k = state[S_K]
     mode = state[S_MODE]
@@ -425,7 +425,7 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
         if n + 2 > buf.shape[0]:
             buf = _grow(buf, n)
             kbuf = _grow_int(kbuf, n)
-        n, done = _goal_reached(buf, n, x, y, gx, gy, tol, occ, ox, oy, res, clear)
+        n, done = _goal_reached(buf, n, x, y, s, cm)
         if done != CODE_RUNNING:
             code = done
             break
@@ -437,9 +437,8 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
             k = advance_progress(x, y, pts, cum, k, r1, occ, ox, oy, res, clear)
             fx, fy, _ = fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0,
                                      r1, r2, occ, ox, oy, res, boundary, offset)
-            dfx, dfy = _discs(x, y, fx, fy, f, i, dpos, dvel, drad)
-            nx, ny, how = _step(x, y, fx + dfx, fy + dfy, step, occ, ox, oy, res, clear, safe,
-                                radius, margin)
+            dfx, dfy = _discs(x, y, fx, fy, cm, ds, dpos, dvel, drad)
+            nx, ny, how = _step(x, y, fx + dfx, fy + dfy, s, cm, margin)
             if how == HOW_BLOCKED:
                 blocked = True
             else:
@@ -470,8 +469,8 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
             if x == tx and y == ty:
                 reached = True
             else:
-                nx, ny, moved, reached = _escape_move(x, y, tx, ty, step, f, i, occ, ox, oy,
-                                                      res, clear, dpos, dvel, drad)
+                nx, ny, moved, reached = _escape_move(x, y, tx, ty, s, cm, ds, dpos, dvel,
+                                                      drad)
                 esteps += 1
                 if not moved or (drad is not None and drad.shape[0] > 0 and esteps > 2 * stall_n):
                     mode = 0  # blocked (or held up by discs): back to Algorithm 2
@@ -503,7 +502,7 @@ def fusion_loop(buf, kbuf, n, max_steps, occ, pts, cum, state, f, i, dpos, dvel,
         if stalled or blocked:
             ri = -1
             rj = -1
-            if escape == 1:
+            if escape:
                 if margin is not None and margin > 0.0:  # a way back keeping the margin first
                     ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox,
                                          oy, res, clear + margin, kbuf, drive)

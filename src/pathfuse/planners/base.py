@@ -26,6 +26,7 @@ from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
+from pathfuse.costmap import costmap_for
 from pathfuse.field.kernels import (
     CODE_BLOCKED,
     CODE_COLLISION,
@@ -33,15 +34,11 @@ from pathfuse.field.kernels import (
     CODE_GOAL_SNAP,
     CODE_RUNNING,
     CODE_STALLED,
-    F_CLEAR,
-    F_MARGIN,
-    F_RVX,
-    F_RVY,
     STATIC,
     code_status,
 )
 from pathfuse.field.motion import MARGIN_FRAC
-from pathfuse.field.settings import disc_settings
+from pathfuse.field.settings import DiscSettings, FieldSettings, FusionSettings, disc_settings
 from pathfuse.geometry import segment_is_clear
 from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.problem import Problem
@@ -332,17 +329,20 @@ class Controller:
 class FieldController(Controller):
     """Shared logic of the potential-field controllers (see the module docstring).
 
-    Subclasses set :attr:`default_step_frac`, fill the settings arrays
-    ``self.f`` and ``self.i`` of their loop, and implement :meth:`_call`, which
-    runs the loop for at most ``max_steps`` moves from ``self.buf[self.n -
-    1]`` and returns ``(code, steps)``.
+    Subclasses set :attr:`default_step_frac`, the named settings ``self.settings``
+    of their loop (:class:`~pathfuse.field.settings.FieldSettings` or
+    :class:`~pathfuse.field.settings.FusionSettings`), and implement
+    :meth:`_call`, which runs the loop on ``self.costmap`` (the
+    :class:`~pathfuse.costmap.Costmap`, without its lattice) with
+    ``self.disc_cfg`` (:class:`~pathfuse.field.settings.DiscSettings`) for at
+    most ``max_steps`` moves from ``self.buf[self.n - 1]`` and returns ``(code,
+    steps)``.
     """
 
     default_step_frac: ClassVar[float] = 0.1
     recovers: ClassVar[bool] = False  # Algorithm 2's escape, and apf/ref6/ref7 as printed
     disc_reach_m: float = math.inf
-    f: np.ndarray
-    i: np.ndarray
+    settings: FieldSettings | FusionSettings
 
     def __init__(self, problem: Problem, params: Any, plan: Any = None, *,
                  dt: float | None = None, max_speed: float | None = None) -> None:
@@ -360,6 +360,10 @@ class FieldController(Controller):
         self.stall_distance_m = float(p.stall_distance_m) if p.stall_distance_m is not None \
             else STALL_FRAC * step
         self.clear_m = problem.robot_radius_m + MARGIN_FRAC * res
+        #: The one collision-checking object of the loop (its clearance is ``clear_m``).
+        self.costmap = costmap_for(g, problem.robot_radius_m, lattice=False)
+        #: The moving discs' settings (the robot's velocity replaced every tick online).
+        self.disc_cfg = self.disc_settings()
         cap = problem.budget.max_iterations
         most = limit("MAX_STEPS")
         if cap is not None:
@@ -380,19 +384,19 @@ class FieldController(Controller):
         self.buf[0] = problem.start
         self.n = 1
 
-    def disc_settings(self) -> tuple:
+    def disc_settings(self) -> DiscSettings:
         """Moving-disc settings for the kernels (no effect without discs)."""
         p = self.params
         return disc_settings(
-            self.problem.robot_radius_m,
             p.k_rep if p.k_rep_moving is None else p.k_rep_moving,
             p.rho0_m if p.rho0_moving_m is None else p.rho0_moving_m,
             self.disc_reach_m, p.repulsion == "velocity", p.a_max, p.swerve)
 
     def _margin(self, dpos: np.ndarray | None) -> tuple[float, ...]:
         """The loops' last argument, the soft safety margin: left out of a static run
-        without one (numba then compiles no margin code), ``f[F_MARGIN]`` otherwise."""
-        m = float(self.f[F_MARGIN])
+        without one (numba then compiles no margin code), the settings' ``margin_m``
+        otherwise."""
+        m = self.settings.margin_m
         return () if dpos is None and m <= 0.0 else (m,)
 
     def _call(self, max_steps: int, dpos: np.ndarray | None, dvel: np.ndarray | None,
@@ -474,12 +478,12 @@ class FieldController(Controller):
             discs = (_plain(sens.positions), _plain(sens.velocities), _plain(sens.radii))
         else:
             discs = _NO_DISCS
-        self.f[F_RVX] = float(obs.velocity[0])
-        self.f[F_RVY] = float(obs.velocity[1])
-        tight = self._tight(x, y)
+        self.disc_cfg = self.disc_cfg._replace(robot_vx_mps=float(obs.velocity[0]),
+                                               robot_vy_mps=float(obs.velocity[1]))
+        costmap = self.costmap
+        self._tight(x, y)
         code, _ = self._call(1, *discs)
-        if tight:
-            self.f[F_CLEAR] = self.clear_m
+        self.costmap = costmap
         if code in (CODE_STALLED, CODE_BLOCKED):
             self.on_stuck()
         if self.n > n0:
@@ -497,7 +501,8 @@ class FieldController(Controller):
     def _tight(self, x: float, y: float) -> bool:
         """Online, a robot that the world left closer to a wall than the controller's
         clearance (a diff-drive robot braking late) may keep what it has for this move;
-        True when the clearance was lowered for it."""
+        True when the clearance of ``self.costmap`` was lowered for it (:meth:`act` puts
+        the Costmap back after the move)."""
         rb = self.problem.robot
         if rb is None or not rb.is_diff_drive:
             return False
@@ -508,7 +513,7 @@ class FieldController(Controller):
                                     float(g.resolution), x, y, x, y, self.clear_m)
         if d >= self.clear_m:
             return False
-        self.f[F_CLEAR] = d * (1.0 - 1e-12)
+        self.costmap = self.costmap._replace(clear_m=d * (1.0 - 1e-12))
         return True
 
     def on_stuck(self) -> None:

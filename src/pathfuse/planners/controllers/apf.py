@@ -67,16 +67,14 @@ class SubgoalController(FieldController):
     def __init__(self, problem: Problem, params: Any, plan: Any = None, **kw: Any) -> None:
         super().__init__(problem, params, plan, **kw)
         p = params
-        g = problem.grid
         self.subgoals = np.require(self.make_subgoals(), dtype=np.float64,
                                    requirements=("C", "W"))
-        ox, oy = g.origin
-        self.f, self.i = pack_field(
+        self.settings = pack_field(
             problem.goal, p.k_att, p.k_rep, p.rho0_m, self.step_m, self.goal_tolerance_m,
-            self.clear_m, p.stall_steps, self.stall_distance_m, ox, oy, g.resolution,
-            self.subgoal_tolerance(), self.improved, self.rep_to_goal(), self.rep_exponent(),
-            self.rep_scale(), self.disc_settings(), p.safe_step, p.stall_exit,
-            problem.clearance_m, p.static_repulsion == "boundary", p.boundary_offset_m)
+            p.stall_steps, self.stall_distance_m, self.subgoal_tolerance(), self.improved,
+            self.rep_to_goal(), self.rep_exponent(), self.rep_scale(), p.safe_step,
+            p.stall_exit, problem.clearance_m, p.static_repulsion == "boundary",
+            p.boundary_offset_m)
         self.state = np.zeros(1, dtype=np.int64)
 
     def make_subgoals(self) -> np.ndarray:
@@ -97,9 +95,9 @@ class SubgoalController(FieldController):
 
     def _call(self, max_steps: int, dpos: np.ndarray | None, dvel: np.ndarray | None,
               drad: np.ndarray | None) -> tuple[int, int]:
-        self.buf, self.n, code, steps = field_loop(self.buf, self.n, max_steps,
-                                                   self.problem.grid.occupied, self.subgoals,
-                                                   self.state, self.f, self.i, dpos, dvel, drad,
+        self.buf, self.n, code, steps = field_loop(self.buf, self.n, max_steps, self.costmap,
+                                                   self.subgoals, self.state, self.settings,
+                                                   self.disc_cfg, dpos, dvel, drad,
                                                    *self._margin(dpos))
         return code, steps
 

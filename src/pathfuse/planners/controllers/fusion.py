@@ -181,13 +181,11 @@ class FusionController(FieldController):
         p = params
         g = problem.grid
         self._set_path(np.asarray(plan.waypoints, dtype=np.float64))
-        ox, oy = g.origin
         window = p.stall_steps * self.step_m + 2.0 * (p.r1_m + g.resolution)
-        self.f, self.i = pack_fusion(
+        self.settings = pack_fusion(
             problem.goal, p.k_att, p.k_rep, p.rho0_m, p.r1_m, p.r2_m, self.step_m,
-            self.goal_tolerance_m, self.clear_m, p.stall_steps, self.stall_distance_m, ox, oy,
-            g.resolution, _AHEAD[p.ahead], p.escape, p.escape_points, window, self.online,
-            self.disc_settings(), p.safe_step, p.stall_exit,
+            self.goal_tolerance_m, p.stall_steps, self.stall_distance_m, _AHEAD[p.ahead],
+            p.escape, p.escape_points, window, self.online, p.safe_step, p.stall_exit,
             problem.clearance_m, p.static_repulsion == "boundary", p.boundary_offset_m)
         self.state = np.zeros(N_S, dtype=np.int64)
         self.kbuf = np.zeros(self.buf.shape[0], dtype=np.int64)
@@ -202,7 +200,7 @@ class FusionController(FieldController):
         self.replans = 0
         self._replan_every = 0
         if self._window is not None and p.replan_period_s > 0:
-            self._replan_every = max(1, int(round(p.replan_period_s / self._window.f[0])))
+            self._replan_every = max(1, int(round(p.replan_period_s / self._window.f.dt_s)))
 
     def command(self, obs: Any) -> np.ndarray:
         """On a diff-drive robot with ``velocity_space`` (ours): Algorithm 2's move for this
@@ -288,8 +286,8 @@ class FusionController(FieldController):
     def _call(self, max_steps: int, dpos: np.ndarray | None, dvel: np.ndarray | None,
               drad: np.ndarray | None) -> tuple[int, int]:
         self.buf, self.kbuf, self.n, code, steps = fusion_loop(
-            self.buf, self.kbuf, self.n, max_steps, self.problem.grid.occupied, self.pts,
-            self.cum, self.state, self.f, self.i, dpos, dvel, drad, *self._margin(dpos))
+            self.buf, self.kbuf, self.n, max_steps, self.costmap, self.pts, self.cum, self.state,
+            self.settings, self.disc_cfg, dpos, dvel, drad, *self._margin(dpos))
         return code, steps
 
     def on_stuck(self) -> None:

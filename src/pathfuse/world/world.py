@@ -396,6 +396,11 @@ class World:
         if not arc:
             return bool(point_segment_distance(gx, gy, p0[0], p0[1], p1[0], p1[1]) <= tol)
         v, w = float(cmd[0]), float(cmd[1])
+        # the whole arc lies within |v w| dt^2 / 8 of its chord (its sagitta's bound): when
+        # the goal is farther than that beyond the tolerance, no chord below can pass it
+        if point_segment_distance(gx, gy, p0[0], p0[1], p1[0], p1[1]) \
+                - abs(v * w) * self.dt ** 2 / 8.0 > tol + 1e-9:
+            return False
         n = max(1, int(math.ceil(math.sqrt(abs(v * w) * self.dt ** 2 / 8.0 / 1e-6))))
         h = self.dt / n
         e = abs(v * w) * h * h / 8.0

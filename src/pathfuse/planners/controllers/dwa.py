@@ -96,7 +96,7 @@ from pathfuse.planners.controllers.dwa_kernel import (
     route_tangent,
 )
 from pathfuse.planners.controllers.replan import replan_around_discs
-from pathfuse.planners.controllers.social import PassingSides, disc_ids
+from pathfuse.planners.controllers.social import PassingSides, disc_ids, path_sides
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, SocialParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -152,6 +152,15 @@ class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
                                    help="replan the global A* path from the robot's position, "
                                         "around the sensed discs, this often (Nav2's default "
                                         "1 Hz; 0 = never)")
+    social_replan: bool = param(True, help="ours: the replanned A* path keeps personal_m "
+                                           "more from the sensed discs where the room allows "
+                                           "(off, or social off: grown by the robot's radius "
+                                           "only)")
+    path_sides: bool = param(True, help="ours: a disc's passing side is committed as the "
+                                        "replanned global path passes it (discs of a group "
+                                        "then get one side; off, or social off: the side of "
+                                        "the chosen rollout); with social_replan, the path "
+                                        "is also replanned as soon as a new disc is sensed")
     passive_safety: bool = param(True, help="plan for the safety shield's passive safety "
                                             "(ours): a pass closer to a sensed disc than it "
                                             "can travel while the robot stops counts as a "
@@ -260,7 +269,10 @@ class DWAController(Controller):
 
     def _replan(self, x: float, y: float) -> None:
         dpos, _, drad = self._sensed
-        pts = replan_around_discs(self.problem, x, y, dpos, drad, self.params)
+        p = self.params
+        pts = replan_around_discs(self.problem, x, y, dpos, drad, p,
+                                  personal_m=p.personal_m if p.social and p.social_replan
+                                  else 0.0)
         self.replans += 1
         if pts is not None:
             self._set_path(pts)
@@ -274,12 +286,19 @@ class DWAController(Controller):
         return True
 
     _pending_replan = False
+    _seen: set[int] = set()
 
     def _choose(self, x: float, y: float, th: float, c0: float, c1: float, dpos: np.ndarray,
                 dvel: np.ndarray, drad: np.ndarray, ids: np.ndarray | None = None
                 ) -> tuple[float, float]:
-        if self._pending_replan or (self.replan_every and self.ticks
-                                    and self.ticks % self.replan_every == 0):
+        p = self.params
+        new_disc = False
+        if ids is not None and p.social and p.social_replan and p.path_sides and len(ids):
+            seen = {int(i) for i in ids}
+            new_disc = bool(seen - self._seen)
+            self._seen = seen
+        if self._pending_replan or new_disc or (self.replan_every and self.ticks
+                                                and self.ticks % self.replan_every == 0):
             self._pending_replan = False
             self._replan(x, y)
         self.ticks += 1
@@ -297,8 +316,10 @@ class DWAController(Controller):
                                       self.pts, self.cum, self.k, dpos, dvel, drad,
                                       self.sides.sides(ids), chosen)
         if n:
+            prefer = path_sides(self.pts, self.k, dpos, drad, self.problem.robot_radius_m,
+                                p.personal_m) if p.social and p.path_sides else None
             self.sides.update(ids, chosen, dpos, (x, y), route, drad,
-                              self.problem.robot_radius_m)
+                              self.problem.robot_radius_m, prefer)
         if count == 0:
             self.no_choice += 1
         return float(a0), float(a1)

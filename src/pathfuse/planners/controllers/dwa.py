@@ -161,6 +161,10 @@ class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
                                         "then get one side; off, or social off: the side of "
                                         "the chosen rollout); with social_replan, the path "
                                         "is also replanned as soon as a new disc is sensed")
+    inside_clearance: bool = param(True, help="ours: when the robot stands inside its own "
+                                              "clearance and no sample keeps it, the samples "
+                                              "that keep the gap it has are admissible "
+                                              "(false: it stands, turning to the path)")
     passive_safety: bool = param(True, help="plan for the safety shield's passive safety "
                                             "(ours): a pass closer to a sensed disc than it "
                                             "can travel while the robot stops counts as a "
@@ -251,7 +255,8 @@ class DWAController(Controller):
             w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
             keep_m=p.keep_m, w_social=p.social_weight if p.social else 0.0,
             personal_m=p.personal_m, w_side=p.side_weight if p.social else 0.0,
-            dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight)
+            dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight,
+            inside_clear=p.inside_clearance)
         self.sides = PassingSides(p.personal_m)
         self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
         self.no_choice = 0

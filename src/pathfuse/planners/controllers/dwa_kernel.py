@@ -69,6 +69,7 @@ class DwaSettings(NamedTuple):
     side_weight: float
     dwell_s: float
     dwell_weight: float
+    inside_clear: bool
 
 
 class DwaTick(NamedTuple):
@@ -84,7 +85,8 @@ class DwaTick(NamedTuple):
 def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, margin, horizon, sim_dt, n_v, n_w, w_path,
              w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead, decay,
              holonomic, passive=True, w_align=0.0, near_s=0.0, w_keep=0.0, keep_m=0.3,
-             w_social=0.0, personal_m=0.5, w_side=0.0, dwell_s=0.0, w_dwell=0.0):
+             w_social=0.0, personal_m=0.5, w_side=0.0, dwell_s=0.0, w_dwell=0.0,
+             inside_clear=False):
     """The settings of :func:`dwa_choose`.
 
     With a safety margin (``margin > 0``) the passing-side critic is off: holding a side
@@ -106,7 +108,8 @@ def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, margin, horizon, sim_dt, n_v, n_
         float(w_path), float(w_goal), float(w_head), float(w_speed), float(w_obs),
         float(w_dyn), float(obstacle_range), float(lookahead), float(decay), bool(holonomic),
         bool(passive), float(w_align), float(near_s), float(w_keep), float(keep_m),
-        float(w_social), float(personal_m), float(w_side), float(dwell_s), float(w_dwell))
+        float(w_social), float(personal_m), float(w_side), float(dwell_s), float(w_dwell),
+        bool(inside_clear))
 
 
 def relaxed(s):
@@ -474,8 +477,17 @@ def dwa_choose(cm, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dsi
                                           dpos, dvel, drad, dside, chosen)
             if count > 0:
                 return a0, a1, count, best
-    return _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside,
-                   chosen)
+    a0, a1, count, best = _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos,
+                                  dvel, drad, dside, chosen)
+    if count == 0 and f.inside_clear:
+        # ours: a robot already inside its own clearance (IR-SIM's Euler step or a push put
+        # it there) finds no sample keeping ``clear``; the samples that keep the gap it has
+        # (moving along the obstacle or away from it) are admissible instead
+        d = segment_distance(cm, x, y, x, y, clear, MARGIN_FRAC * cm.res_m)
+        if d < clear:
+            a0, a1, count, best = _choose(cm, f, d * (1.0 - 1e-9), tick, x, y, th, c0, c1, pts,
+                                          cum, k, dpos, dvel, drad, dside, chosen)
+    return a0, a1, count, best
 
 
 @njit(cache=True)

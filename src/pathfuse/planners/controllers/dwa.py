@@ -96,7 +96,13 @@ from pathfuse.planners.controllers.dwa_kernel import (
     route_tangent,
 )
 from pathfuse.planners.controllers.replan import replan_around_discs
-from pathfuse.planners.controllers.social import PassingSides, disc_ids, path_sides
+from pathfuse.planners.controllers.social import (
+    EVERY_DISC,
+    PassingSides,
+    SteadyDiscs,
+    disc_ids,
+    path_sides,
+)
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, SocialParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -165,6 +171,16 @@ class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
                                               "clearance and no sample keeps it, the samples "
                                               "that keep the gap it has are admissible "
                                               "(false: it stands, turning to the path)")
+    dwell_s: float = param(1.5, ge=0, le=30, unit="s",
+                           help="yield outside a walker's lane (ours): a rollout pays "
+                                "dwell_weight where it ends within personal_m of the lane a "
+                                "sensed disc, predicted at constant velocity, sweeps in the "
+                                "dwell_s after the rollout (the spot where the robot may have "
+                                "to stand); 0 = off (dwa's default was 0 before issue 18's "
+                                "dwa work)")
+    dwell_steady: bool = param(False, help="ours: the dwell critic counts only the steady "
+                                           "discs (social.SteadyDiscs, as the fusion's); "
+                                           "false: every sensed disc")
     passive_safety: bool = param(True, help="plan for the safety shield's passive safety "
                                             "(ours): a pass closer to a sensed disc than it "
                                             "can travel while the robot stops counts as a "
@@ -258,6 +274,7 @@ class DWAController(Controller):
             dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight,
             inside_clear=p.inside_clearance)
         self.sides = PassingSides(p.personal_m)
+        self.steady = SteadyDiscs(self.tick_s)
         self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
         self.no_choice = 0
         self._sensed = _NO_DISCS
@@ -316,7 +333,10 @@ class DWAController(Controller):
         ids = np.arange(n) if ids is None else ids
         chosen = np.zeros((n, 2))
         route = route_tangent(self.pts, self.k, th)
-        tick = dwa_tick(self.costmap, f, self.pts, self.cum, self.k, route)
+        steady = EVERY_DISC
+        if n and p.social and p.dwell_s > 0.0 and p.dwell_steady:
+            steady = self.steady.update(ids, dvel)  # ours, as the fusion's (SteadyDiscs)
+        tick = dwa_tick(self.costmap, f, self.pts, self.cum, self.k, route, steady)
         a0, a1, count, _ = dwa_choose(self.costmap, f, tick, x, y, th, c0, c1,
                                       self.pts, self.cum, self.k, dpos, dvel, drad,
                                       self.sides.sides(ids), chosen)

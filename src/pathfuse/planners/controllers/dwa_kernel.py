@@ -80,6 +80,9 @@ class DwaTick(NamedTuple):
     route_x: float
     route_y: float
     """The route direction against which passing sides are told (``(0, 0)``: the path's)."""
+    steady: np.ndarray = EVERY_DISC
+    """The dwell critic's mask of the sensed discs it counts (empty: every disc;
+    :class:`~pathfuse.planners.controllers.social.SteadyDiscs`)."""
 
 
 def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, margin, horizon, sim_dt, n_v, n_w, w_path,
@@ -128,10 +131,11 @@ def keep_reference(cm, s, pts, cum, k):
     return math.inf
 
 
-def dwa_tick(cm, s, pts, cum, k, route):
+def dwa_tick(cm, s, pts, cum, k, route, steady=EVERY_DISC):
     """The :class:`DwaTick` of this tick: the keep reference along ``pts`` from ``k``
-    (:func:`keep_reference`) and the route direction ``route``."""
-    return DwaTick(keep_reference(cm, s, pts, cum, k), float(route[0]), float(route[1]))
+    (:func:`keep_reference`), the route direction ``route`` and the dwell critic's mask."""
+    return DwaTick(keep_reference(cm, s, pts, cum, k), float(route[0]), float(route[1]),
+                   steady)
 
 
 @njit(cache=True, inline="always")
@@ -239,7 +243,7 @@ def path_gap(cm, s, pts, cum, k, length):
 # geometry is in helpers (dwa_checks, _path_distance, dwell_shortfall).
 @njit(cache=True)
 def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, drad, out, tx,
-             ty, dside, sides, reach):
+             ty, dside, sides, reach, steady):
     """Score one sample: ``out = [cost, admissible, first_tick_clear]``; ``sides[j] = (side,
     least predicted gap)`` of the sample against sensed disc ``j`` (the social critics,
     :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction);
@@ -387,7 +391,7 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, dpos, dvel, dr
     if n_disc > 0 and f.dwell_s > 0.0 and f.dwell_weight > 0.0:
         # ours (the dwell critic): the robot may have to stand where the rollout ends
         dwc = f.dwell_weight * dwell_shortfall(ex, ey, tend, dpos, dvel, drad, radius,
-                                               f.dwell_s, personal, EVERY_DISC)
+                                               f.dwell_s, personal, steady)
     # the end point against the path near the progress index: its distance to the path and
     # how much path is left beyond its projection
     m = pts.shape[0]
@@ -544,7 +548,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                 sp = math.hypot(ux, uy)
                 hd = math.atan2(uy, ux) if sp > 0.0 else th
                 _rollout(cm, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg,
-                         dpos, dvel, drad, out, tx, ty, dside, sides, reach)
+                         dpos, dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
                 if out[1] == 1.0 and n_disc > 0:
                     out[0] += _passive_penalty(holonomic_stop_disc_gap(
                         x, y, ux, uy, dt, amax, cm.radius_m, discs))
@@ -575,7 +579,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
             else:
                 w = min(max(0.0, wlo), whi)  # always try going straight
             _rollout(cm, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, dpos, dvel,
-                     drad, out, tx, ty, dside, sides, reach)
+                     drad, out, tx, ty, dside, sides, reach, tick.steady)
             if out[1] == 1.0 and n_disc > 0:
                 out[0] += _passive_penalty(unicycle_stop_disc_gap(
                     x, y, th, v, w, dt, amax, f.max_yaw_accel_radps2, cm.radius_m, discs))

@@ -19,8 +19,8 @@ Two critics of the sampled rollouts (in :mod:`pathfuse.planners.controllers.dwa_
   the robot or no longer sensed.  The robot picks a side once instead of
   swinging between two people or in front of one.
 
-A third critic, **dwell** (``dwell_s``, on by default in the fusion among discs, off in
-``dwa`` and ``mppi``): a rollout ends where the robot may have to stand.  Each sensed
+A third critic, **dwell** (``dwell_s``, on by default in the fusion among discs and in
+``dwa``, off in ``mppi``): a rollout ends where the robot may have to stand.  Each sensed
 disc, predicted at constant velocity, sweeps a lane in the ``dwell_s`` after the
 rollout's end; a rollout ending within ``personal_m`` of that lane pays
 ``dwell_weight`` times the shortfall (relative, halved for a disc that arrives only at
@@ -28,7 +28,12 @@ the end of ``dwell_s``): :func:`dwell_shortfall`.  The robot then waits outside 
 walker's lane, not in it (a walker that does not react walks into a robot standing in
 its way).
 
-``social: false`` (a parameter of ``dwa``, ``fusion`` and ``mppi``) turns all three off.
+``dwa`` adds (ours, its parameters ``social_replan`` and ``path_sides``): its replanned
+global path keeps ``personal_m`` more from the sensed discs where the room allows, and a
+disc's passing side is committed as that path passes it (:func:`path_sides`), so the discs
+of a group get one side.
+
+``social: false`` (a parameter of ``dwa``, ``fusion`` and ``mppi``) turns all of them off.
 """
 
 from __future__ import annotations

@@ -124,7 +124,9 @@ def test_switch_off_is_the_planner_without_the_critics():
         a = simulate(sc, planner={"name": name, "params": {"social": False}})
         b = simulate(sc, planner={"name": name, "params": {"social_weight": 0.0,
                                                            **({} if name == "mppi" else
-                                                              {"side_weight": 0.0})}})
+                                                              {"side_weight": 0.0,
+                                                               "dwell_s": 0.0,
+                                                               "social_replan": False})}})
         np.testing.assert_array_equal(a.positions, b.positions)
 
 

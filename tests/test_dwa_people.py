@@ -44,8 +44,9 @@ def test_dwa_waits_outside_the_lane_of_a_head_on_pair():
 
 
 def test_dwa_commits_one_side_to_a_group():
-    """path_sides: without it dwa committed to pass two walkers of the RVO crowd on
-    opposite sides, between them, and was walked into (rvo_crowd, seed 2)."""
+    """path_sides (and the immediate replan on a new disc that comes with it): without it dwa
+    stood turning on the spot among the RVO crowd and was walked into (rvo_crowd, seed 2);
+    the group rule itself is checked in test_path_sides_and_a_group_conflict."""
     world = WORLDS / "rvo_crowd.yaml"
     ep = run_irsim_episode(world, "dwa", 2)
     assert _ok(ep)

@@ -43,7 +43,7 @@ def test_dwa_waits_outside_the_lane_of_a_head_on_pair():
     assert off.status.name == "COLLISION" and off.collision_with == "person"
 
 
-def test_dwa_commits_one_side_to_a_group():
+def test_path_sides_keeps_dwa_from_standing_in_the_rvo_crowd():
     """path_sides (and the immediate replan on a new disc that comes with it): without it dwa
     stood turning on the spot among the RVO crowd and was walked into (rvo_crowd, seed 2);
     the group rule itself is checked in test_path_sides_and_a_group_conflict."""

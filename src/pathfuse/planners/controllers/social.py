@@ -44,8 +44,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-__all__ = ["PassingSides", "SteadyDiscs", "disc_ids", "dwell_shortfall", "path_sides", "COMMIT_M", "BEHIND_M",
-           "STEADY_S", "EVERY_DISC"]
+__all__ = ["PassingSides", "SteadyDiscs", "disc_ids", "dwell_shortfall", "path_sides",
+           "COMMIT_M", "BEHIND_M", "STEADY_S", "EVERY_DISC"]
 
 COMMIT_M = 1.0
 """A disc whose predicted gap to the chosen command's rollout is below ``personal_m``

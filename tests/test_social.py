@@ -124,7 +124,9 @@ def test_switch_off_is_the_planner_without_the_critics():
         a = simulate(sc, planner={"name": name, "params": {"social": False}})
         b = simulate(sc, planner={"name": name, "params": {"social_weight": 0.0,
                                                            **({} if name == "mppi" else
-                                                              {"side_weight": 0.0})}})
+                                                              {"side_weight": 0.0,
+                                                               "dwell_s": 0.0,
+                                                               "social_replan": False})}})
         np.testing.assert_array_equal(a.positions, b.positions)
 
 
@@ -162,11 +164,12 @@ def test_dwell_shortfall_matches_a_sampled_lane():
     assert 30 < hits < 270  # both kinds of case were drawn
 
 
-def test_dwell_critic_is_switchable_and_off_by_default_in_dwa_and_mppi():
+def test_dwell_critic_is_switchable_on_in_dwa_and_the_fusion_off_in_mppi():
     from pathfuse.planners.registry import get_planner
 
     assert get_planner("fusion").defaults()["dwell_s"] == 1.5
-    assert get_planner("dwa").defaults()["dwell_s"] == 0.0
+    assert get_planner("dwa").defaults()["dwell_s"] == 1.5  # since dwa among people
+    assert get_planner("dwa").defaults()["dwell_steady"] is False
     assert get_planner("mppi").defaults()["dwell_s"] == 0.0
     _, s = _settings()
     assert s.dwell_s == 0.0  # SocialParams' own default (off)

@@ -207,7 +207,8 @@ class PersonalSpaceParams(Checked):
                            help="yield outside a walker's lane (ours): a rollout pays "
                                 "dwell_weight where it ends within personal_m of the lane a "
                                 "sensed disc (in mppi and the fusion only a steady one, that "
-                                "kept its velocity for 1 s), predicted at constant velocity, "
+                                "kept its velocity for 1 s; in dwa every one unless "
+                                "dwell_steady), predicted at constant velocity, "
                                 "sweeps in the "
                                 "dwell_s after the rollout (the spot where the robot may have "
                                 "to stand); 0 = off")

@@ -96,7 +96,13 @@ from pathfuse.planners.controllers.dwa_kernel import (
     route_tangent,
 )
 from pathfuse.planners.controllers.replan import replan_around_discs
-from pathfuse.planners.controllers.social import PassingSides, disc_ids
+from pathfuse.planners.controllers.social import (
+    EVERY_DISC,
+    PassingSides,
+    SteadyDiscs,
+    disc_ids,
+    path_sides,
+)
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, SocialParams
 from pathfuse.planners.registry import PlannerSpec, register
 from pathfuse.problem import Problem
@@ -152,6 +158,29 @@ class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
                                    help="replan the global A* path from the robot's position, "
                                         "around the sensed discs, this often (Nav2's default "
                                         "1 Hz; 0 = never)")
+    social_replan: bool = param(True, help="ours: the replanned A* path keeps personal_m "
+                                           "more from the sensed discs where the room allows "
+                                           "(off, or social off: grown by the robot's radius "
+                                           "only)")
+    path_sides: bool = param(True, help="ours: a disc's passing side is committed as the "
+                                        "replanned global path passes it (discs of a group "
+                                        "then get one side; off, or social off: the side of "
+                                        "the chosen rollout); with social_replan, the path "
+                                        "is also replanned as soon as a new disc is sensed")
+    inside_clearance: bool = param(True, help="ours: when the robot stands inside its own "
+                                              "clearance and no sample keeps it, the samples "
+                                              "that keep the gap it has are admissible "
+                                              "(false: it stands, turning to the path)")
+    dwell_s: float = param(1.5, ge=0, le=30, unit="s",
+                           help="yield outside a walker's lane (ours): a rollout pays "
+                                "dwell_weight where it ends within personal_m of the lane a "
+                                "sensed disc, predicted at constant velocity, sweeps in the "
+                                "dwell_s after the rollout (the spot where the robot may have "
+                                "to stand); 0 = off (dwa's default was 0 before issue 18's "
+                                "dwa work)")
+    dwell_steady: bool = param(False, help="ours: the dwell critic counts only the steady "
+                                           "discs (social.SteadyDiscs, as the fusion's); "
+                                           "false: every sensed disc")
     passive_safety: bool = param(True, help="plan for the safety shield's passive safety "
                                             "(ours): a pass closer to a sensed disc than it "
                                             "can travel while the robot stops counts as a "
@@ -242,8 +271,10 @@ class DWAController(Controller):
             w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
             keep_m=p.keep_m, w_social=p.social_weight if p.social else 0.0,
             personal_m=p.personal_m, w_side=p.side_weight if p.social else 0.0,
-            dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight)
+            dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight,
+            inside_clear=p.inside_clearance)
         self.sides = PassingSides(p.personal_m)
+        self.steady = SteadyDiscs(self.tick_s)
         self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
         self.no_choice = 0
         self._sensed = _NO_DISCS
@@ -260,7 +291,10 @@ class DWAController(Controller):
 
     def _replan(self, x: float, y: float) -> None:
         dpos, _, drad = self._sensed
-        pts = replan_around_discs(self.problem, x, y, dpos, drad, self.params)
+        p = self.params
+        pts = replan_around_discs(self.problem, x, y, dpos, drad, p,
+                                  personal_m=p.personal_m if p.social and p.social_replan
+                                  else 0.0)
         self.replans += 1
         if pts is not None:
             self._set_path(pts)
@@ -274,12 +308,19 @@ class DWAController(Controller):
         return True
 
     _pending_replan = False
+    _seen: set[int] = set()
 
     def _choose(self, x: float, y: float, th: float, c0: float, c1: float, dpos: np.ndarray,
                 dvel: np.ndarray, drad: np.ndarray, ids: np.ndarray | None = None
                 ) -> tuple[float, float]:
-        if self._pending_replan or (self.replan_every and self.ticks
-                                    and self.ticks % self.replan_every == 0):
+        p = self.params
+        new_disc = False
+        if ids is not None and p.social and p.social_replan and p.path_sides and len(ids):
+            seen = {int(i) for i in ids}
+            new_disc = bool(seen - self._seen)
+            self._seen = seen
+        if self._pending_replan or new_disc or (self.replan_every and self.ticks
+                                                and self.ticks % self.replan_every == 0):
             self._pending_replan = False
             self._replan(x, y)
         self.ticks += 1
@@ -292,13 +333,18 @@ class DWAController(Controller):
         ids = np.arange(n) if ids is None else ids
         chosen = np.zeros((n, 2))
         route = route_tangent(self.pts, self.k, th)
-        tick = dwa_tick(self.costmap, f, self.pts, self.cum, self.k, route)
+        steady = EVERY_DISC
+        if n and p.social and p.dwell_s > 0.0 and p.dwell_steady:
+            steady = self.steady.update(ids, dvel)  # ours, as the fusion's (SteadyDiscs)
+        tick = dwa_tick(self.costmap, f, self.pts, self.cum, self.k, route, steady)
         a0, a1, count, _ = dwa_choose(self.costmap, f, tick, x, y, th, c0, c1,
                                       self.pts, self.cum, self.k, dpos, dvel, drad,
                                       self.sides.sides(ids), chosen)
         if n:
+            prefer = path_sides(self.pts, self.k, dpos, drad, self.problem.robot_radius_m,
+                                p.personal_m) if p.social and p.path_sides else None
             self.sides.update(ids, chosen, dpos, (x, y), route, drad,
-                              self.problem.robot_radius_m)
+                              self.problem.robot_radius_m, prefer)
         if count == 0:
             self.no_choice += 1
         return float(a0), float(a1)

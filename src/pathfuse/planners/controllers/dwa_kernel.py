@@ -74,6 +74,7 @@ class DwaSettings(NamedTuple):
     side_weight: float
     dwell_s: float
     dwell_weight: float
+    inside_clear: bool
 
 
 class DwaTick(NamedTuple):
@@ -84,12 +85,16 @@ class DwaTick(NamedTuple):
     route_x: float
     route_y: float
     """The route direction against which passing sides are told (``(0, 0)``: the path's)."""
+    steady: np.ndarray = EVERY_DISC
+    """The dwell critic's mask of the sensed discs it counts (empty: every disc;
+    :class:`~pathfuse.planners.controllers.social.SteadyDiscs`)."""
 
 
 def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, margin, horizon, sim_dt, n_v, n_w, w_path,
              w_goal, w_head, w_speed, w_obs, w_dyn, obstacle_range, lookahead, decay,
              holonomic, passive=True, w_align=0.0, near_s=0.0, w_keep=0.0, keep_m=0.3,
-             w_social=0.0, personal_m=0.5, w_side=0.0, dwell_s=0.0, w_dwell=0.0):
+             w_social=0.0, personal_m=0.5, w_side=0.0, dwell_s=0.0, w_dwell=0.0,
+             inside_clear=False):
     """The settings of :func:`dwa_choose`.
 
     With a safety margin (``margin > 0``) the passing-side critic is off: holding a side
@@ -111,7 +116,8 @@ def pack_dwa(dt, vmin, vmax, amax, wmax, alpha, margin, horizon, sim_dt, n_v, n_
         float(w_path), float(w_goal), float(w_head), float(w_speed), float(w_obs),
         float(w_dyn), float(obstacle_range), float(lookahead), float(decay), bool(holonomic),
         bool(passive), float(w_align), float(near_s), float(w_keep), float(keep_m),
-        float(w_social), float(personal_m), float(w_side), float(dwell_s), float(w_dwell))
+        float(w_social), float(personal_m), float(w_side), float(dwell_s), float(w_dwell),
+        bool(inside_clear))
 
 
 def relaxed(s):
@@ -130,10 +136,11 @@ def keep_reference(cm, s, pts, cum, k):
     return math.inf
 
 
-def dwa_tick(cm, s, pts, cum, k, route):
+def dwa_tick(cm, s, pts, cum, k, route, steady=EVERY_DISC):
     """The :class:`DwaTick` of this tick: the keep reference along ``pts`` from ``k``
-    (:func:`keep_reference`) and the route direction ``route``."""
-    return DwaTick(keep_reference(cm, s, pts, cum, k), float(route[0]), float(route[1]))
+    (:func:`keep_reference`), the route direction ``route`` and the dwell critic's mask."""
+    return DwaTick(keep_reference(cm, s, pts, cum, k), float(route[0]), float(route[1]),
+                   steady)
 
 
 @njit(cache=True, inline="always")
@@ -216,7 +223,7 @@ def path_gap(cm, s, pts, cum, k, length):
 # geometry is in helpers (dwa_checks, _path_distance, dwell_shortfall).
 @njit(cache=True)
 def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel, drad, out,
-             tx, ty, dside, sides, reach):
+             tx, ty, dside, sides, reach, steady):
     """Score one sample: ``out = [cost, admissible, first_tick_clear]``; ``sides[j] = (side,
     least predicted gap)`` of the sample against sensed disc ``j`` (the social critics,
     :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction);
@@ -370,7 +377,7 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel
     if n_disc > 0 and f.dwell_s > 0.0 and f.dwell_weight > 0.0:
         # ours (the dwell critic): the robot may have to stand where the rollout ends
         dwc = f.dwell_weight * dwell_shortfall(ex, ey, tend, dpos, dvel, drad, radius,
-                                               f.dwell_s, personal, EVERY_DISC)
+                                               f.dwell_s, personal, steady)
     # the end point against the path near the progress index: its distance to the path and
     # how much path is left beyond its projection
     m = pts.shape[0]
@@ -460,8 +467,17 @@ def dwa_choose(cm, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dsi
                                           dpos, dvel, drad, dside, chosen)
             if count > 0:
                 return a0, a1, count, best
-    return _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside,
-                   chosen)
+    a0, a1, count, best = _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos,
+                                  dvel, drad, dside, chosen)
+    if count == 0 and f.inside_clear:
+        # ours: a robot already inside its own clearance (IR-SIM's Euler step or a push put
+        # it there) finds no sample keeping ``clear``; the samples that keep the gap it has
+        # (moving along the obstacle or away from it) are admissible instead
+        d = segment_distance(cm, x, y, x, y, clear, MARGIN_FRAC * cm.res_m)
+        if d < clear:
+            a0, a1, count, best = _choose(cm, f, d * (1.0 - 1e-9), tick, x, y, th, c0, c1, pts,
+                                          cum, k, dpos, dvel, drad, dside, chosen)
+    return a0, a1, count, best
 
 
 @njit(cache=True)
@@ -519,7 +535,7 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                 sp = math.hypot(ux, uy)
                 hd = math.atan2(uy, ux) if sp > 0.0 else th
                 _rollout(cm, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg, bb,
-                         dpos, dvel, drad, out, tx, ty, dside, sides, reach)
+                         dpos, dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
                 if out[1] == 1.0 and n_disc > 0:
                     out[0] += _passive_penalty(holonomic_stop_disc_gap(
                         x, y, ux, uy, dt, amax, cm.radius_m, discs))
@@ -549,8 +565,8 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                                                 whi)
             else:
                 w = min(max(0.0, wlo), whi)  # always try going straight
-            _rollout(cm, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel,
-                     drad, out, tx, ty, dside, sides, reach)
+            _rollout(cm, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, bb, dpos,
+                     dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
             if out[1] == 1.0 and n_disc > 0:
                 out[0] += _passive_penalty(unicycle_stop_disc_gap(
                     x, y, th, v, w, dt, amax, f.max_yaw_accel_radps2, cm.radius_m, discs))

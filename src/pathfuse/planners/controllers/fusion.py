@@ -147,8 +147,7 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                                 "pays dwell_weight where it ends within personal_m of the lane "
                                 "a steady sensed disc (one that kept its velocity for 1 s), "
                                 "predicted at constant velocity, sweeps in the "
-                                "dwell_s after the rollout; 0 = off (the default of dwa and "
-                                "mppi)")
+                                "dwell_s after the rollout; 0 = off (the default of mppi)")
     velocity_space: bool = param(True, help="diff-drive robot online: choose (v, omega) from "
                                             "the dynamic window by agreement with Algorithm "
                                             "2's move, clearance and the predicted discs "

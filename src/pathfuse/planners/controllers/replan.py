@@ -24,7 +24,8 @@ __all__ = ["replan_around_discs"]
 
 def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
                         drad: np.ndarray, params: Any,
-                        clearance_m: float | None = None) -> np.ndarray | None:
+                        clearance_m: float | None = None,
+                        personal_m: float = 0.0) -> np.ndarray | None:
     """Waypoints ``(M, 2)`` of a new global path from ``(x, y)`` to the goal, or None.
 
     Parameters
@@ -42,6 +43,9 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
     clearance_m : float, optional
         A* only: the soft margin it keeps from obstacles where the room allows,
         when larger than the problem's (``mppi``'s ``replan_clearance_m``).
+    personal_m : float
+        A* only (ours, ``dwa``'s ``social_replan``): the discs are first blocked grown by
+        this much more (a person's personal space); when that leaves no path, as without.
 
     Returns
     -------
@@ -54,17 +58,28 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
     from pathfuse.planners.globals.astar import plan_global
 
     occ = None
+    here = problem.with_start((x, y))
+    if clearance_m is not None and clearance_m > here.clearance_m:
+        here = dataclasses.replace(here, clearance_m=clearance_m)
+    gp = None
     if drad.shape[0]:
         from pathfuse.planners.controllers.follow import _rasterise_discs
 
         g = problem.grid
-        occ = g.cspace(problem.robot_radius_m).occupied.copy()
-        _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
-                         dpos, drad, float(problem.robot_radius_m))
-    here = problem.with_start((x, y))
-    if clearance_m is not None and clearance_m > here.clearance_m:
-        here = dataclasses.replace(here, clearance_m=clearance_m)
-    gp = plan_global(here, params.heuristic, occupied=occ)
+        static = g.cspace(problem.robot_radius_m).occupied
+        if personal_m > 0.0:
+            occ = static.copy()
+            _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
+                             dpos, drad, float(problem.robot_radius_m) + float(personal_m))
+            gp = plan_global(here, params.heuristic, occupied=occ)
+            if not gp.success:
+                gp = None
+        if gp is None:
+            occ = static.copy()
+            _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]),
+                             float(g.resolution), dpos, drad, float(problem.robot_radius_m))
+    if gp is None:
+        gp = plan_global(here, params.heuristic, occupied=occ)
     if not gp.success and occ is not None:  # boxed in by the discs: the static path
         gp = plan_global(here, params.heuristic)
     return np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2) if gp.success else None

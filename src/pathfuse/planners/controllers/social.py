@@ -19,8 +19,8 @@ Two critics of the sampled rollouts (in :mod:`pathfuse.planners.controllers.dwa_
   the robot or no longer sensed.  The robot picks a side once instead of
   swinging between two people or in front of one.
 
-A third critic, **dwell** (``dwell_s``, on by default in the fusion among discs, off in
-``dwa`` and ``mppi``): a rollout ends where the robot may have to stand.  Each sensed
+A third critic, **dwell** (``dwell_s``, on by default in the fusion among discs and in
+``dwa``, off in ``mppi``): a rollout ends where the robot may have to stand.  Each sensed
 disc, predicted at constant velocity, sweeps a lane in the ``dwell_s`` after the
 rollout's end; a rollout ending within ``personal_m`` of that lane pays
 ``dwell_weight`` times the shortfall (relative, halved for a disc that arrives only at
@@ -28,7 +28,12 @@ the end of ``dwell_s``): :func:`dwell_shortfall`.  The robot then waits outside 
 walker's lane, not in it (a walker that does not react walks into a robot standing in
 its way).
 
-``social: false`` (a parameter of ``dwa``, ``fusion`` and ``mppi``) turns all three off.
+``dwa`` adds (ours, its parameters ``social_replan`` and ``path_sides``): its replanned
+global path keeps ``personal_m`` more from the sensed discs where the room allows, and a
+disc's passing side is committed as that path passes it (:func:`path_sides`), so the discs
+of a group get one side.
+
+``social: false`` (a parameter of ``dwa``, ``fusion`` and ``mppi``) turns all of them off.
 """
 
 from __future__ import annotations
@@ -39,8 +44,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-__all__ = ["PassingSides", "SteadyDiscs", "disc_ids", "dwell_shortfall", "COMMIT_M", "BEHIND_M",
-           "STEADY_S", "EVERY_DISC"]
+__all__ = ["PassingSides", "SteadyDiscs", "disc_ids", "dwell_shortfall", "path_sides",
+           "COMMIT_M", "BEHIND_M", "STEADY_S", "EVERY_DISC"]
 
 COMMIT_M = 1.0
 """A disc whose predicted gap to the chosen command's rollout is below ``personal_m``
@@ -79,9 +84,13 @@ class PassingSides:
         return np.array([self.committed.get(int(i), 0.0) for i in ids], dtype=np.float64)
 
     def update(self, ids: np.ndarray, chosen: np.ndarray, dpos: np.ndarray,
-               position: Any, tangent: Any, drad: np.ndarray, radius: float) -> None:
+               position: Any, tangent: Any, drad: np.ndarray, radius: float,
+               prefer: np.ndarray | None = None) -> None:
         """After a tick: ``chosen[j] = (side, predicted gap)`` of the chosen command's
-        rollout against sensed disc ``j``; ``tangent`` the route's direction at the robot."""
+        rollout against sensed disc ``j``; ``tangent`` the route's direction at the robot.
+        ``prefer[j]``, when given and not 0, is the side committed instead of the chosen
+        rollout's (ours, ``dwa``'s ``path_sides``: the side the global path passes it on,
+        :func:`path_sides`)."""
         keep: dict[int, float] = {}
         tx, ty = float(tangent[0]), float(tangent[1])
         for j, i in enumerate(ids):
@@ -94,10 +103,69 @@ class PassingSides:
             if side == 0.0 and chosen[j, 0] != 0.0 \
                     and chosen[j, 1] < self.personal_m + COMMIT_M:
                 side = float(chosen[j, 0])
+                if prefer is not None and prefer[j] != 0.0:
+                    side = float(prefer[j])
                 self.commits += 1
             if side != 0.0:
                 keep[key] = side
+        if prefer is not None:
+            # ours (path_sides): two committed discs too close together for the robot to
+            # pass between them with its personal space, committed to opposite sides (the
+            # second was sensed after the first was committed), take the path's sides
+            js = [j for j, i in enumerate(ids) if int(i) in keep]
+            for a in js:
+                for b in js:
+                    ka, kb = int(ids[a]), int(ids[b])
+                    if b <= a or keep[ka] == keep[kb]:
+                        continue
+                    d = math.hypot(float(dpos[a, 0] - dpos[b, 0]), float(dpos[a, 1] - dpos[b, 1]))
+                    if d < float(drad[a] + drad[b]) + 2.0 * (radius + self.personal_m):
+                        if prefer[a] != 0.0:
+                            keep[ka] = float(prefer[a])
+                        if prefer[b] != 0.0:
+                            keep[kb] = float(prefer[b])
         self.committed = keep
+
+
+def path_sides(pts: np.ndarray, k: int, dpos: np.ndarray, drad: np.ndarray, radius: float,
+               personal_m: float, ahead_m: float = 8.0) -> np.ndarray:
+    """The side (+1 left, -1 right, 0 none) of the path ``pts`` (from its point ``k``, over
+    ``ahead_m`` of it) on which each disc lies, told at the path point nearest the disc
+    against the path's direction there; 0 when the path passes farther than ``radius +
+    drad + personal_m + 1 m`` or through it (ours, ``dwa``'s ``path_sides``).  A path
+    planned around the discs, as the replanned one is, never goes between two discs
+    closer together than the robot, so the discs of a group get one side.
+
+    >>> pts = np.array([[0.0, 0.0], [2.0, 0.0], [4.0, 0.0]])
+    >>> path_sides(pts, 0, np.array([[2.0, 0.9], [3.0, -0.8], [2.0, 5.0]]),
+    ...            np.full(3, 0.25), 0.25, 0.5).tolist()
+    [1.0, -1.0, 0.0]
+    """
+    out = np.zeros(drad.shape[0])
+    m = pts.shape[0]
+    for i in range(drad.shape[0]):
+        best = math.inf
+        side = 0.0
+        run = 0.0
+        j = max(0, min(int(k), m - 1))
+        while j + 1 < m and run <= ahead_m:
+            ax, ay = float(pts[j, 0]), float(pts[j, 1])
+            vx, vy = float(pts[j + 1, 0]) - ax, float(pts[j + 1, 1]) - ay
+            l2 = vx * vx + vy * vy
+            run += math.sqrt(l2)
+            j += 1
+            if l2 <= 0.0:
+                continue
+            qx, qy = float(dpos[i, 0]) - ax, float(dpos[i, 1]) - ay
+            u = min(1.0, max(0.0, (qx * vx + qy * vy) / l2))
+            d = math.hypot(qx - u * vx, qy - u * vy)
+            if d < best:
+                best = d
+                cr = vx * qy - vy * qx
+                side = 1.0 if cr > 0.0 else -1.0
+        if best < radius + float(drad[i]) + personal_m + COMMIT_M and best > 0.5 * radius:
+            out[i] = side
+    return out
 
 
 EVERY_DISC = np.zeros(0, dtype=np.bool_)

@@ -388,9 +388,23 @@ def test_dwa_in_irsim_does_not_drive_into_a_wall():
 def test_fusion_waits_outside_a_crossing_stream():
     """Regression: among a stream of people crossing its corridor the fusion drove into
     their lane and was walked into from behind (crossing_stream, seed 3); the dwell
-    critic keeps it out of the lane."""
+    critic keeps it out of the lane (without the replanned path's personal space, which
+    alone also avoids it now)."""
     world = Path(example_worlds_dir()) / "crossing_stream.yaml"
-    ep = run_irsim_episode(world, "fusion", 3, {"seed": 3})
+    ep = run_irsim_episode(world, "fusion", 3, {"seed": 3, "social_replan": False})
     assert ep.status.name == "SUCCESS" and ep.social.min_gap_m > 0.3
-    off = run_irsim_episode(world, "fusion", 3, {"seed": 3, "dwell_s": 0.0})
+    off = run_irsim_episode(world, "fusion", 3, {"seed": 3, "dwell_s": 0.0,
+                                                  "social_replan": False})
+    assert off.status.name == "COLLISION" and off.collision_with == "person"
+
+
+def test_fusion_replans_with_personal_space_around_a_head_on_pair():
+    """social_replan (ours, as dwa's): after passing the first pair low the fusion stood in
+    the second pair's lane, turned to flee ahead of them and was walked into
+    (corridor_head_on, seed 6); with the replanned path keeping personal_m from the people
+    it passes both pairs."""
+    world = Path(example_worlds_dir()) / "corridor_head_on.yaml"
+    ep = run_irsim_episode(world, "fusion", 6, {"seed": 6})
+    assert ep.status.name == "SUCCESS" and ep.social.min_gap_m > 0.3
+    off = run_irsim_episode(world, "fusion", 6, {"seed": 6, "social_replan": False})
     assert off.status.name == "COLLISION" and off.collision_with == "person"

@@ -135,6 +135,9 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
         help="diff-drive robot online, velocity space, while a moving disc is sensed: plan "
              "the global path again from the robot, around the sensed discs, this often "
              "(ours, as dwa; 0 = never)")
+    social_replan: bool = param(
+        True, help="ours, with social and replan_period_s: the replanned A* path keeps "
+                   "personal_m more from the sensed discs where the room allows (as dwa)")
     among_discs: str = param(
         "mppi", choices=("mppi", "window"),
         help="diff-drive robot online, velocity space, while a moving disc is sensed: track "
@@ -235,8 +238,11 @@ class FusionController(FieldController):
         if not (drad.shape[0] and self._replan_every and self._ticks % self._replan_every == 0
                 and int(self.state[S_MODE]) == 0):
             return
+        p = self.params
         pts = replan_around_discs(self.problem, float(obs.position[0]),
-                                  float(obs.position[1]), dpos, drad, self.params)
+                                  float(obs.position[1]), dpos, drad, p,
+                                  personal_m=p.personal_m if p.social and p.social_replan
+                                  else 0.0)
         self.replans += 1
         if pts is None:
             return

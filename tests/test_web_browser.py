@@ -66,7 +66,8 @@ def _wait_until_planners_answer(url, proc):
                 if proc.poll() is not None:
                     raise AssertionError(f"pathfuse serve exited: {proc.stderr.read()}") from None
                 if time.monotonic() > deadline:
-                    raise AssertionError(f"{planner}: no plan answered within {WAIT_MS} ms") from None
+                    raise AssertionError(
+                        f"{planner}: no plan answered within {WAIT_MS} ms") from None
                 time.sleep(1.0)
 
 

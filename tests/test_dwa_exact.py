@@ -4,15 +4,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from pathfuse.costmap import costmap_for, segment_distance
+from pathfuse.costmap import costmap_for, field_distance, segment_distance
 from pathfuse.grid import GridMap
 from pathfuse.planners.controllers.dwa_checks import (
+    _field_bound,
     _path_distance,
     _segment_distance,
+    _straight_pose,
     _sweep_gap,
     path_blocks,
 )
-from pathfuse.sweep import disc_sweep_gaps
+from pathfuse.sweep import disc_sweep_gaps, unicycle_pose
 
 
 def _map() -> GridMap:
@@ -117,3 +119,35 @@ def test_path_distance_blocks_are_a_scan_of_every_segment() -> None:
             j = int(rng.integers(0, m))
             x, y = pts[j] + rng.normal(scale=float(rng.choice([0.0, 0.03, 0.5, 5.0])), size=2)
             assert _path_distance(pts, cum, k, jg, bb, x, y) == _scan(pts, cum, k, jg, x, y)
+
+
+def test_straight_pose_is_unicycle_pose() -> None:
+    # w == 0 (+0 or -0): the angle's cosine and sine taken once at any h > 0 serve every t
+    rng = np.random.default_rng(6)
+    for _ in range(5000):
+        x, y = rng.normal(scale=float(rng.choice([0.0, 1.0, 50.0])), size=2)
+        th = float(rng.choice([0.0, -0.0, np.pi, -np.pi, rng.uniform(-4.0, 4.0)]))
+        v = float(rng.choice([0.0, rng.uniform(0.0, 2.0), -rng.uniform(0.0, 2.0)]))
+        w = float(rng.choice([0.0, -0.0]))
+        h = float(rng.choice([0.1, 0.05, rng.uniform(1e-3, 1.0)]))
+        mid = th + 0.5 * (w * h)
+        cmid, smid = np.cos(mid), np.sin(mid)
+        for t in (h, 2.0 * h, float(rng.uniform(1e-6, 3.0)), 0.0):
+            want = unicycle_pose(x, y, th, v, w, t)
+            got = _straight_pose(x, y, th, v, w, t, cmid, smid)
+            assert [np.float64(a).tobytes() for a in got] == \
+                [np.float64(a).tobytes() for a in want]
+
+
+def test_field_bound_is_field_distance_to_rounding() -> None:
+    # sqrt for hypot: a few units in the last place, far within the 1e-9 m that
+    # _segment_distance's test keeps to spare (its exactness: the test above)
+    g = _map()
+    rng = np.random.default_rng(7)
+    for radius in (0.1, 0.333):
+        cm = costmap_for(g, radius)
+        for _ in range(5000):
+            x = rng.uniform(cm.ox_m - 1.0, cm.xmax_m + 1.0)
+            y = rng.uniform(cm.oy_m - 1.0, cm.ymax_m + 1.0)
+            want = field_distance(cm, x, y)[0]
+            assert abs(_field_bound(cm, x, y) - want) <= 1e-13 * (1.0 + abs(want))

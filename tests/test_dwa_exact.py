@@ -14,7 +14,8 @@ from pathfuse.planners.controllers.dwa_checks import (
     _sweep_gap,
     path_blocks,
 )
-from pathfuse.sweep import disc_sweep_gaps, unicycle_pose
+from pathfuse.geometry import segment_box_distance
+from pathfuse.sweep import disc_sweep_gaps, segment_static_distance, unicycle_pose
 
 
 def _map() -> GridMap:
@@ -151,3 +152,60 @@ def test_field_bound_is_field_distance_to_rounding() -> None:
             y = rng.uniform(cm.oy_m - 1.0, cm.ymax_m + 1.0)
             want = field_distance(cm, x, y)[0]
             assert abs(_field_bound(cm, x, y) - want) <= 1e-13 * (1.0 + abs(want))
+
+
+def _ring_search(occ: np.ndarray, ox: float, oy: float, res: float, ax: float, ay: float,
+                 bx: float, by: float, cap: float, slack: float) -> float:
+    """segment_static_distance as it was before its bounding-box test (the ring search,
+    which computes the exact distance of every occupied square it visits)."""
+    h, w = occ.shape
+    best = cap
+    for px, py in ((ax, ay), (bx, by)):
+        de = min(px - ox, ox + w * res - px, py - oy, oy + h * res - py)
+        if de < 0.0 or (de == 0.0 and slack == 0.0):
+            return 0.0
+        best = min(best, de + slack)
+    c0 = min(max(int(np.floor((min(ax, bx) - ox) / res)), 0), w - 1)
+    c1 = min(max(int(np.floor((max(ax, bx) - ox) / res)), 0), w - 1)
+    r0 = min(max(int(np.floor((min(ay, by) - oy) / res)), 0), h - 1)
+    r1 = min(max(int(np.floor((max(ay, by) - oy) / res)), 0), h - 1)
+    k = 0
+    while True:
+        if k >= 1 and (k - 1) * res >= best:
+            break
+        if r0 - k < 0 and c0 - k < 0 and r1 + k >= h and c1 + k >= w:
+            break
+        for rr in range(max(r0 - k, 0), min(r1 + k, h - 1) + 1):
+            for cc in range(max(c0 - k, 0), min(c1 + k, w - 1) + 1):
+                ring = k == 0 or rr in (r0 - k, r1 + k) or cc in (c0 - k, c1 + k)
+                if ring and occ[rr, cc]:
+                    x0, y0 = ox + cc * res, oy + rr * res
+                    best = min(best, segment_box_distance(ax, ay, bx, by, x0, y0, x0 + res,
+                                                          y0 + res))
+        k += 1
+    return best
+
+
+def test_segment_static_distance_is_every_square() -> None:
+    # the squares skipped by their gap to the segment's bounding box change nothing: the
+    # same value as the exact distance of every square the ring search visits (segments
+    # along, across, touching and inside the squares, short and long, caps small and large)
+    g = _map()
+    occ, (ox, oy), res = g.occupied, g.origin, g.resolution
+    rng = np.random.default_rng(8)
+    near = 0
+    for _ in range(1500):
+        ax = float(rng.uniform(ox, ox + occ.shape[1] * res))
+        ay = float(rng.uniform(oy, oy + occ.shape[0] * res))
+        if rng.random() < 0.3:  # on a square's edge or corner
+            ax, ay = ox + round((ax - ox) / res) * res, oy + round((ay - oy) / res) * res
+        length = float(rng.choice([0.0, 0.05, 0.1, 0.3, 1.5]))
+        a = float(rng.choice([0.0, np.pi / 2, np.pi / 4, rng.uniform(0.0, 2.0 * np.pi)]))
+        bx, by = ax + length * np.cos(a), ay + length * np.sin(a)
+        cap = float(rng.choice([0.05, 0.2, 0.6, 2.0, np.inf]))
+        slack = float(rng.choice([0.0, 1e-7]))
+        want = _ring_search(occ, ox, oy, res, ax, ay, bx, by, cap, slack)
+        got = segment_static_distance(occ, ox, oy, res, ax, ay, bx, by, cap, slack)
+        assert got == want, (ax, ay, bx, by, cap, slack)
+        near += 0.0 < want < cap
+    assert near > 300

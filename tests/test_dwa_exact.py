@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from pathfuse.costmap import costmap_for, field_distance, segment_distance
+from pathfuse.geometry import segment_box_distance
 from pathfuse.grid import GridMap
 from pathfuse.planners.controllers.dwa_checks import (
     _field_bound,
@@ -14,7 +15,6 @@ from pathfuse.planners.controllers.dwa_checks import (
     _sweep_gap,
     path_blocks,
 )
-from pathfuse.geometry import segment_box_distance
 from pathfuse.sweep import disc_sweep_gaps, segment_static_distance, unicycle_pose
 
 

@@ -4,15 +4,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from pathfuse.costmap import costmap_for, segment_distance
+from pathfuse.costmap import costmap_for, field_distance, segment_distance
+from pathfuse.geometry import segment_box_distance
 from pathfuse.grid import GridMap
 from pathfuse.planners.controllers.dwa_checks import (
+    _field_bound,
     _path_distance,
     _segment_distance,
+    _straight_pose,
     _sweep_gap,
     path_blocks,
 )
-from pathfuse.sweep import disc_sweep_gaps
+from pathfuse.sweep import disc_sweep_gaps, segment_static_distance, unicycle_pose
 
 
 def _map() -> GridMap:
@@ -117,3 +120,92 @@ def test_path_distance_blocks_are_a_scan_of_every_segment() -> None:
             j = int(rng.integers(0, m))
             x, y = pts[j] + rng.normal(scale=float(rng.choice([0.0, 0.03, 0.5, 5.0])), size=2)
             assert _path_distance(pts, cum, k, jg, bb, x, y) == _scan(pts, cum, k, jg, x, y)
+
+
+def test_straight_pose_is_unicycle_pose() -> None:
+    # w == 0 (+0 or -0): the angle's cosine and sine taken once at any h > 0 serve every t
+    rng = np.random.default_rng(6)
+    for _ in range(5000):
+        x, y = rng.normal(scale=float(rng.choice([0.0, 1.0, 50.0])), size=2)
+        th = float(rng.choice([0.0, -0.0, np.pi, -np.pi, rng.uniform(-4.0, 4.0)]))
+        v = float(rng.choice([0.0, rng.uniform(0.0, 2.0), -rng.uniform(0.0, 2.0)]))
+        w = float(rng.choice([0.0, -0.0]))
+        h = float(rng.choice([0.1, 0.05, rng.uniform(1e-3, 1.0)]))
+        mid = th + 0.5 * (w * h)
+        cmid, smid = np.cos(mid), np.sin(mid)
+        for t in (h, 2.0 * h, float(rng.uniform(1e-6, 3.0)), 0.0):
+            want = unicycle_pose(x, y, th, v, w, t)
+            got = _straight_pose(x, y, th, v, w, t, cmid, smid)
+            assert [np.float64(a).tobytes() for a in got] == \
+                [np.float64(a).tobytes() for a in want]
+
+
+def test_field_bound_is_field_distance_to_rounding() -> None:
+    # sqrt for hypot: a few units in the last place, far within the 1e-9 m that
+    # _segment_distance's test keeps to spare (its exactness: the test above)
+    g = _map()
+    rng = np.random.default_rng(7)
+    for radius in (0.1, 0.333):
+        cm = costmap_for(g, radius)
+        for _ in range(5000):
+            x = rng.uniform(cm.ox_m - 1.0, cm.xmax_m + 1.0)
+            y = rng.uniform(cm.oy_m - 1.0, cm.ymax_m + 1.0)
+            want = field_distance(cm, x, y)[0]
+            assert abs(_field_bound(cm, x, y) - want) <= 1e-13 * (1.0 + abs(want))
+
+
+def _ring_search(occ: np.ndarray, ox: float, oy: float, res: float, ax: float, ay: float,
+                 bx: float, by: float, cap: float, slack: float) -> float:
+    """segment_static_distance as it was before its bounding-box test (the ring search,
+    which computes the exact distance of every occupied square it visits)."""
+    h, w = occ.shape
+    best = cap
+    for px, py in ((ax, ay), (bx, by)):
+        de = min(px - ox, ox + w * res - px, py - oy, oy + h * res - py)
+        if de < 0.0 or (de == 0.0 and slack == 0.0):
+            return 0.0
+        best = min(best, de + slack)
+    c0 = min(max(int(np.floor((min(ax, bx) - ox) / res)), 0), w - 1)
+    c1 = min(max(int(np.floor((max(ax, bx) - ox) / res)), 0), w - 1)
+    r0 = min(max(int(np.floor((min(ay, by) - oy) / res)), 0), h - 1)
+    r1 = min(max(int(np.floor((max(ay, by) - oy) / res)), 0), h - 1)
+    k = 0
+    while True:
+        if k >= 1 and (k - 1) * res >= best:
+            break
+        if r0 - k < 0 and c0 - k < 0 and r1 + k >= h and c1 + k >= w:
+            break
+        for rr in range(max(r0 - k, 0), min(r1 + k, h - 1) + 1):
+            for cc in range(max(c0 - k, 0), min(c1 + k, w - 1) + 1):
+                ring = k == 0 or rr in (r0 - k, r1 + k) or cc in (c0 - k, c1 + k)
+                if ring and occ[rr, cc]:
+                    x0, y0 = ox + cc * res, oy + rr * res
+                    best = min(best, segment_box_distance(ax, ay, bx, by, x0, y0, x0 + res,
+                                                          y0 + res))
+        k += 1
+    return best
+
+
+def test_segment_static_distance_is_every_square() -> None:
+    # the squares skipped by their gap to the segment's bounding box change nothing: the
+    # same value as the exact distance of every square the ring search visits (segments
+    # along, across, touching and inside the squares, short and long, caps small and large)
+    g = _map()
+    occ, (ox, oy), res = g.occupied, g.origin, g.resolution
+    rng = np.random.default_rng(8)
+    near = 0
+    for _ in range(1500):
+        ax = float(rng.uniform(ox, ox + occ.shape[1] * res))
+        ay = float(rng.uniform(oy, oy + occ.shape[0] * res))
+        if rng.random() < 0.3:  # on a square's edge or corner
+            ax, ay = ox + round((ax - ox) / res) * res, oy + round((ay - oy) / res) * res
+        length = float(rng.choice([0.0, 0.05, 0.1, 0.3, 1.5]))
+        a = float(rng.choice([0.0, np.pi / 2, np.pi / 4, rng.uniform(0.0, 2.0 * np.pi)]))
+        bx, by = ax + length * np.cos(a), ay + length * np.sin(a)
+        cap = float(rng.choice([0.05, 0.2, 0.6, 2.0, np.inf]))
+        slack = float(rng.choice([0.0, 1e-7]))
+        want = _ring_search(occ, ox, oy, res, ax, ay, bx, by, cap, slack)
+        got = segment_static_distance(occ, ox, oy, res, ax, ay, bx, by, cap, slack)
+        assert got == want, (ax, ay, bx, by, cap, slack)
+        near += 0.0 < want < cap
+    assert near > 300

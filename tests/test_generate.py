@@ -207,6 +207,7 @@ def test_label_regions_equal_scipy_labels(monkeypatch, small):
     import pathfuse.grid as grid_mod
 
     monkeypatch.setattr(grid_mod, "SMALL_LABELS", small)
+    monkeypatch.setattr(grid_mod, "_scipy_loaded", lambda: False)  # (imported just above)
     rng = np.random.default_rng(5)
     regions = []
     for _ in range(800):

@@ -25,6 +25,7 @@ that this convention holds for every map in pathfuse.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, cast
@@ -44,6 +45,12 @@ __all__ = ["GridMap", "label_regions"]
 SMALL_LABELS = 1 << 12
 
 
+def _scipy_loaded() -> bool:
+    """Whether scipy.ndimage is imported already (:func:`label_regions` then needs no
+    import)."""
+    return "scipy.ndimage" in sys.modules
+
+
 def label_regions(free: np.ndarray, eight: bool = False) -> np.ndarray:
     """The labels of ``scipy.ndimage.label(free)`` (4-connected; ``eight``: 8-connected),
     as an int32 array: 0 on blocked cells, regions numbered in the order of their first
@@ -51,7 +58,9 @@ def label_regions(free: np.ndarray, eight: bool = False) -> np.ndarray:
 
     On a small map (at most :data:`SMALL_LABELS` cells, the paper's 15 x 15) a flood fill
     in Python computes them, which spares a first plan the import of scipy.ndimage (a
-    quarter of a CPU second); scipy on a larger one.
+    quarter of a CPU second); scipy on a larger one, and on any once it is imported (a
+    replan around moving discs labels a map per replan: about 1 ms in Python on a
+    40 x 48 map, 0.05 ms in scipy).
 
     >>> label_regions(np.array([[True, False, True], [False, True, True]])).tolist()
     [[1, 0, 2], [0, 2, 2]]
@@ -59,7 +68,7 @@ def label_regions(free: np.ndarray, eight: bool = False) -> np.ndarray:
     [[1, 0], [0, 1]]
     """
     free = np.asarray(free, dtype=bool)
-    if free.size > SMALL_LABELS:
+    if free.size > SMALL_LABELS or _scipy_loaded():
         from scipy import ndimage
 
         labels, _ = ndimage.label(free, structure=np.ones((3, 3), bool) if eight else None)

@@ -118,6 +118,12 @@ def segment_static_distance(occ: np.ndarray, ox: float, oy: float, res: float, a
     c1 = min(max(c1, 0), w - 1)
     r0 = min(max(r0, 0), h - 1)
     r1 = min(max(r1, 0), h - 1)
+    sx0 = min(ax, bx)
+    sx1 = max(ax, bx)
+    sy0 = min(ay, by)
+    sy1 = max(ay, by)
+    tol = 1e-9 * (1.0 + abs(ax) + abs(ay) + abs(bx) + abs(by))  # far above rounding
+    lim = best + tol + 1e-9 * best
     k = 0
     while True:
         # every cell of ring k is at least (k - 1) cells away from the segment
@@ -135,9 +141,16 @@ def segment_static_distance(occ: np.ndarray, ox: float, oy: float, res: float, a
                 if 0 <= cc < w and occ[rr, cc]:
                     x0 = ox + cc * res
                     y0 = oy + rr * res
-                    d = segment_box_distance(ax, ay, bx, by, x0, y0, x0 + res, y0 + res)
-                    if d < best:
-                        best = d
+                    # the square's gap to the segment's bounding box, a lower bound of its
+                    # distance: beyond best by more than tol, the square cannot lower
+                    # best, and its exact distance is left out (the same result)
+                    gx = max(x0 - sx1, sx0 - (x0 + res), 0.0)
+                    gy = max(y0 - sy1, sy0 - (y0 + res), 0.0)
+                    if gx * gx + gy * gy <= lim * lim:
+                        d = segment_box_distance(ax, ay, bx, by, x0, y0, x0 + res, y0 + res)
+                        if d < best:
+                            best = d
+                            lim = best + tol + 1e-9 * best
                 cc += step if step > 0 else 1
         k += 1
     return best

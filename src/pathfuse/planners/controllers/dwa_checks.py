@@ -12,9 +12,10 @@ import math
 import numpy as np
 from numba import njit
 
-from pathfuse.costmap import field_distance, segment_distance
+from pathfuse.costmap import segment_distance
 
-__all__ = ["BLOCK", "_path_distance", "_segment_distance", "_sweep_gap", "path_blocks"]
+__all__ = ["BLOCK", "_path_distance", "_segment_distance", "_straight_pose", "_sweep_gap",
+           "path_blocks"]
 
 
 @njit(cache=True, inline="always")
@@ -37,6 +38,23 @@ def _sweep_gap(ax, ay, bx, by, radius, qax, qay, qbx, qby, rq):
 
 
 @njit(cache=True, inline="always")
+def _field_bound(cm, x, y):
+    """:func:`pathfuse.costmap.field_distance`'s first value with ``sqrt`` for ``hypot`` (a
+    few units in the last place apart, far within the 1e-9 m that
+    :func:`_segment_distance`'s test keeps to spare; glibc's ``hypot`` was a fifth of the
+    kernel's time)."""
+    ox = cm.ox_m
+    oy = cm.oy_m
+    r = cm.field_res_m
+    h, w = cm.field.shape
+    c = min(max(int(math.floor((x - ox) / r)), 0), w - 1)
+    q = min(max(int(math.floor((y - oy) / r)), 0), h - 1)
+    ex = x - (ox + (c + 0.5) * r)
+    ey = y - (oy + (q + 0.5) * r)
+    return cm.field[q, c] - math.sqrt(ex * ex + ey * ey)
+
+
+@njit(cache=True, inline="always")
 def _segment_distance(cm, ax, ay, bx, by, cap, slack):
     """:func:`pathfuse.costmap.segment_distance`, the same value, with an exact shortcut:
     when the costmap's clearance lattice (a lower bound of the distance to the occupied
@@ -44,8 +62,8 @@ def _segment_distance(cm, ax, ay, bx, by, cap, slack):
     its length) puts every square beyond ``cap`` (with 1e-9 to spare for rounding), no
     square can lower the result, which is then ``cap`` or the distance to the map's edge
     (computed as :func:`pathfuse.sweep.segment_static_distance` does)."""
-    half = 0.5 * math.hypot(bx - ax, by - ay)
-    lb, _ = field_distance(cm, 0.5 * (ax + bx), 0.5 * (ay + by))
+    half = 0.5 * math.sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay))
+    lb = _field_bound(cm, 0.5 * (ax + bx), 0.5 * (ay + by))
     if not (lb - half > cap + 1e-9 * (1.0 + cap)):
         return segment_distance(cm, ax, ay, bx, by, cap, slack)
     h, w = cm.occ.shape
@@ -64,6 +82,18 @@ def _segment_distance(cm, ax, ay, bx, by, cap, slack):
         if de < best:
             best = de
     return best
+
+
+@njit(cache=True, inline="always")
+def _straight_pose(x, y, th, v, w, t, cmid, smid):
+    """:func:`pathfuse.sweep.unicycle_pose` for ``w == 0`` and ``t > 0`` (a straight rollout:
+    every holonomic sample), bit for bit, with ``cmid, smid`` the cosine and sine of
+    ``th + 0.5 * (w * h)`` for any ``h > 0``: the angle ``th + w t / 2`` is that same value
+    at every ``t > 0`` (``w t`` is a zero of ``w``'s sign), so the rollout computes them
+    once instead of per piece."""
+    a = w * t
+    chord = v * t * (1.0 - a * a / 24.0)
+    return x + chord * cmid, y + chord * smid, th + a
 
 
 BLOCK = 4
@@ -98,9 +128,9 @@ def path_blocks(pts, k, jg):
 
 
 @njit(cache=True, inline="always")
-def _segment_point(pts, j, x, y):
-    """Distance from ``(x, y)`` to the path's segment ``j`` and the segment parameter of the
-    projection."""
+def _segment_offset(pts, j, x, y):
+    """The offset from the projection of ``(x, y)`` on the path's segment ``j`` to it and the
+    segment parameter of the projection."""
     ax0 = pts[j, 0]
     ay0 = pts[j, 1]
     vx = pts[j + 1, 0] - ax0
@@ -109,7 +139,7 @@ def _segment_point(pts, j, x, y):
     tt = 0.0
     if l2 > 0.0:
         tt = min(max(((x - ax0) * vx + (y - ay0) * vy) / l2, 0.0), 1.0)
-    return math.hypot(x - (ax0 + tt * vx), y - (ay0 + tt * vy)), tt
+    return x - (ax0 + tt * vx), y - (ay0 + tt * vy), tt
 
 
 @njit(cache=True, inline="always")
@@ -142,8 +172,8 @@ def _path_distance(pts, cum, k, jg, bb, x, y):
                 dn = db
                 bn = b
         for j in range(k + bn * BLOCK, min(k + (bn + 1) * BLOCK, end)):
-            dd, _ = _segment_point(pts, j, x, y)
-            bound = min(bound, dd)
+            ex, ey, _ = _segment_offset(pts, j, x, y)
+            bound = min(bound, math.sqrt(ex * ex + ey * ey))  # within 1e-9 of the hypot
     pd = np.inf
     s_at = cum[m - 1]
     j = k
@@ -153,9 +183,13 @@ def _path_distance(pts, cum, k, jg, bb, x, y):
             if _box_distance(bb, b, x, y) > min(pd, bound) + 1e-9:
                 j += BLOCK
                 continue
-        dd, tt = _segment_point(pts, j, x, y)
-        if dd < pd:
-            pd = dd
-            s_at = cum[j] + tt * (cum[j + 1] - cum[j])
+        ex, ey, tt = _segment_offset(pts, j, x, y)
+        # a segment whose squared distance is beyond pd's (by far more than rounding) is
+        # not nearer: its hypot, the costly part, is left out
+        if ex * ex + ey * ey <= pd * pd * (1.0 + 1e-9):
+            dd = math.hypot(ex, ey)
+            if dd < pd:
+                pd = dd
+                s_at = cum[j] + tt * (cum[j + 1] - cum[j])
         j += 1
     return pd, s_at

@@ -22,6 +22,7 @@ from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.controllers.dwa_checks import (
     _path_distance,
     _segment_distance,
+    _straight_pose,
     _sweep_gap,
     path_blocks,
 )
@@ -276,9 +277,15 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel
     ey = y
     eth = th
     tend = 0.0
+    straight = w == 0.0  # (every holonomic sample) its pose's angle is the same at every t
+    cmid = math.cos(th + 0.5 * (w * h))
+    smid = math.sin(th + 0.5 * (w * h))
     for i in range(1, n + 1):
         t = min(i * h, horizon)
-        bx, by, bth = unicycle_pose(x, y, th, v, w, t)
+        if straight:
+            bx, by, bth = _straight_pose(x, y, th, v, w, t, cmid, smid)
+        else:
+            bx, by, bth = unicycle_pose(x, y, th, v, w, t)
         # the search stops at the least distance that could still change something (the
         # clearance, the least gap so far, the keep critic's): a square farther than that
         # changes nothing, and a nearer one is found at the same distance, bit for bit

@@ -408,3 +408,15 @@ def test_fusion_replans_with_personal_space_around_a_head_on_pair():
     assert ep.status.name == "SUCCESS" and ep.social.min_gap_m > 0.3
     off = run_irsim_episode(world, "fusion", 6, {"seed": 6, "social_replan": False})
     assert off.status.name == "COLLISION" and off.collision_with == "person"
+
+
+def test_mppi_replans_with_personal_space_around_a_head_on_pair():
+    """social_replan (ours, as dwa's and the fusion's): without it mppi is walked into by
+    the head-on pair (corridor_head_on, seed 1); with its replanned path keeping personal_m
+    from the people it reaches the goal (passing 0.04 m from them: no collision, though not
+    the personal space)."""
+    world = Path(example_worlds_dir()) / "corridor_head_on.yaml"
+    ep = run_irsim_episode(world, "mppi", 1, {"seed": 1})
+    assert ep.status.name == "SUCCESS"
+    off = run_irsim_episode(world, "mppi", 1, {"seed": 1, "social_replan": False})
+    assert off.status.name == "COLLISION" and off.collision_with == "person"

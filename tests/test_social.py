@@ -123,10 +123,10 @@ def test_switch_off_is_the_planner_without_the_critics():
     for name in ("dwa", "mppi"):
         a = simulate(sc, planner={"name": name, "params": {"social": False}})
         b = simulate(sc, planner={"name": name, "params": {"social_weight": 0.0,
+                                                           "social_replan": False,
                                                            **({} if name == "mppi" else
                                                               {"side_weight": 0.0,
-                                                               "dwell_s": 0.0,
-                                                               "social_replan": False})}})
+                                                               "dwell_s": 0.0})}})
         np.testing.assert_array_equal(a.positions, b.positions)
 
 

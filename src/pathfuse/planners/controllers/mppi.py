@@ -193,6 +193,9 @@ class MPPIParams(PersonalSpaceParams, GlobalAStarParams):
                                       help="the replanned A* path pays to come closer than "
                                            "this to an obstacle (the cost-aware A* of a safety "
                                            "margin; 0 = the plain A*)")
+    social_replan: bool = param(True, help="ours, with social: the replanned A* path keeps "
+                                           "personal_m more from the sensed discs where the "
+                                           "room allows (as dwa and the fusion)")
     stall_steps: int = param(50, ge=1, help="offline: look-back of the stall test, in ticks")
     stall_distance_m: float = param(0.05, gt=0, unit="m",
                                     help="offline: a net move below this over stall_steps "
@@ -302,8 +305,11 @@ class MPPIController(Controller):
         dpos, _, drad = self._sensed
         # keep away from obstacles where the room allows (ours; Nav2's global costmap is
         # inflated likewise)
-        pts = replan_around_discs(self.problem, x, y, dpos, drad, self.params,
-                                  clearance_m=self.params.replan_clearance_m)
+        p = self.params
+        pts = replan_around_discs(self.problem, x, y, dpos, drad, p,
+                                  clearance_m=p.replan_clearance_m,
+                                  personal_m=p.personal_m if p.social and p.social_replan
+                                  else 0.0)
         self.replans += 1
         if pts is not None:
             self._set_path(pts)

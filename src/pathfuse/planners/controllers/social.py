@@ -28,10 +28,10 @@ the end of ``dwell_s``): :func:`dwell_shortfall`.  The robot then waits outside 
 walker's lane, not in it (a walker that does not react walks into a robot standing in
 its way).
 
-``dwa`` adds (ours, its parameters ``social_replan`` and ``path_sides``): its replanned
-global path keeps ``personal_m`` more from the sensed discs where the room allows, and a
-disc's passing side is committed as that path passes it (:func:`path_sides`), so the discs
-of a group get one side.
+``dwa``, ``mppi`` and the fusion replan their global path among discs keeping
+``personal_m`` more from them where the room allows (ours, ``social_replan``), and ``dwa``
+commits a disc's passing side as that path passes it (ours, ``path_sides``:
+:func:`path_sides`), so the discs of a group get one side.
 
 ``social: false`` (a parameter of ``dwa``, ``fusion`` and ``mppi``) turns all of them off.
 """

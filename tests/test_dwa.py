@@ -132,3 +132,20 @@ def test_dwa_dodges_a_head_on_disc_where_astar_walks_into_it():
     # within 1 mm before, and under the shield was stopped in the disc's way and hit)
     assert ep.min_obstacle_distance_m > 0.1
     assert ep.shield_counts["asked"] == ep.n_ticks
+
+
+def test_steadiness_starts_again_for_a_disc_out_of_sight():
+    """dwell_steady: a disc's velocity history is dropped on a tick it is not sensed, so a
+    disc seen again is not steady before it has been watched for a second again."""
+    sc = World(dict(HALL, robot={"model": "diff-drive"})).scenario
+    model = World(dict(HALL, robot={"model": "diff-drive"})).robot
+    pb = Problem.create(sc.grid, sc.start, sc.goal, model.radius_m, robot=model)
+    ctrl = start_online(get_planner("dwa"), pb, DWAParams(dwell_steady=True), 0.1,
+                        model.max_speed_mps)
+    one = (np.array([[8.0, 2.5]]), np.array([[-0.5, 0.0]]), np.array([0.3]), np.array([7]))
+    none = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0, dtype=np.int64))
+    for _ in range(12):
+        ctrl._choose(1.5, 2.5, 0.0, 0.0, 0.0, *one)
+    assert len(ctrl.steady.hist[7]) > ctrl.steady.n  # watched long enough: steady
+    ctrl._choose(1.5, 2.5, 0.0, 0.0, 0.0, *none)
+    assert 7 not in ctrl.steady.hist

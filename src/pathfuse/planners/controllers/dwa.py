@@ -334,8 +334,12 @@ class DWAController(Controller):
         chosen = np.zeros((n, 2))
         route = route_tangent(self.pts, self.k, th)
         steady = EVERY_DISC
-        if n and p.social and p.dwell_s > 0.0 and p.dwell_steady:
-            steady = self.steady.update(ids, dvel)  # ours, as the fusion's (SteadyDiscs)
+        if p.social and p.dwell_s > 0.0 and p.dwell_steady:
+            # ours, as the fusion's (SteadyDiscs); every tick, so a disc that was out of
+            # sight starts its history again
+            mask = self.steady.update(ids, dvel)
+            if n:
+                steady = mask
         tick = dwa_tick(self.costmap, f, self.pts, self.cum, self.k, route, steady)
         a0, a1, count, _ = dwa_choose(self.costmap, f, tick, x, y, th, c0, c1,
                                       self.pts, self.cum, self.k, dpos, dvel, drad,

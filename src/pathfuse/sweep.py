@@ -48,6 +48,7 @@ from numba import njit
 from pathfuse.geometry import segment_box_distance
 
 __all__ = [
+    "edge_distance",
     "segment_static_distance",
     "disc_sweep_gaps",
     "unicycle_pose",
@@ -63,6 +64,26 @@ FINE_TOL_M = 1e-9
 """Arc pieces are halved until their chord bound is below this (where it matters)."""
 _COARSE_TOL_M = 1e-4
 _MAX_PIECES = 1 << 14
+
+
+@njit(cache=True, inline="always")
+def edge_distance(xmin: float, ymin: float, xmax: float, ymax: float, ax: float, ay: float,
+                  bx: float, by: float, cap: float, edge_slack: float) -> float:
+    """``min(cap, distance)`` from segment ``a-b`` to the outside of the rectangle
+    ``[xmin, xmax] x [ymin, ymax]`` plus ``edge_slack`` (0 when an end lies outside, or on
+    the edge without slack): inside a rectangle the distance to its boundary is concave, so
+    its least over the segment is at an end point."""
+    best = cap
+    for i in range(2):
+        px = ax if i == 0 else bx
+        py = ay if i == 0 else by
+        de = min(px - xmin, xmax - px, py - ymin, ymax - py)
+        if de < 0.0 or (de == 0.0 and edge_slack == 0.0):
+            return 0.0
+        de += edge_slack
+        if de < best:
+            best = de
+    return best
 
 
 @njit(cache=True)
@@ -94,22 +115,9 @@ def segment_static_distance(occ: np.ndarray, ox: float, oy: float, res: float, a
         0 when the segment touches an occupied square or leaves the map.
     """
     h, w = occ.shape
-    xmin = ox
-    ymin = oy
-    xmax = ox + w * res
-    ymax = oy + h * res
-    best = cap
-    # the map's outside: inside a rectangle, the distance to its boundary is
-    # concave, so its minimum over the segment is at an end point
-    for i in range(2):
-        px = ax if i == 0 else bx
-        py = ay if i == 0 else by
-        de = min(px - xmin, xmax - px, py - ymin, ymax - py)
-        if de < 0.0 or (de == 0.0 and edge_slack == 0.0):
-            return 0.0
-        de += edge_slack
-        if de < best:
-            best = de
+    best = edge_distance(ox, oy, ox + w * res, oy + h * res, ax, ay, bx, by, cap, edge_slack)
+    if best == 0.0:
+        return 0.0
     c0 = int(math.floor((min(ax, bx) - ox) / res))
     c1 = int(math.floor((max(ax, bx) - ox) / res))
     r0 = int(math.floor((min(ay, by) - oy) / res))

@@ -216,6 +216,10 @@ class PersonalSpaceParams(Checked):
                                 help="weight of the dwell critic (dwell_s), times the "
                                      "shortfall against personal_m, relative, halved for a "
                                      "disc that reaches the spot only at the end of dwell_s")
+    social_replan: bool = param(True, help="ours, with social: the A* path replanned around "
+                                           "the sensed discs keeps personal_m more from them "
+                                           "where the room allows (off, or social off: they "
+                                           "are grown by the robot's radius only)")
 
 
 @dataclass(frozen=True)

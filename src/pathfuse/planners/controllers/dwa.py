@@ -158,10 +158,6 @@ class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
                                    help="replan the global A* path from the robot's position, "
                                         "around the sensed discs, this often (Nav2's default "
                                         "1 Hz; 0 = never)")
-    social_replan: bool = param(True, help="ours: the replanned A* path keeps personal_m "
-                                           "more from the sensed discs where the room allows "
-                                           "(off, or social off: grown by the robot's radius "
-                                           "only)")
     path_sides: bool = param(True, help="ours: a disc's passing side is committed as the "
                                         "replanned global path passes it (discs of a group "
                                         "then get one side; off, or social off: the side of "

@@ -13,6 +13,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.costmap import segment_distance
+from pathfuse.sweep import edge_distance
 
 __all__ = ["BLOCK", "_path_distance", "_segment_distance", "_straight_pose", "_sweep_gap",
            "path_blocks"]
@@ -61,27 +62,15 @@ def _segment_distance(cm, ax, ay, bx, by, cap, slack):
     squares, :func:`pathfuse.costmap.field_distance`, at the segment's midpoint less half
     its length) puts every square beyond ``cap`` (with 1e-9 to spare for rounding), no
     square can lower the result, which is then ``cap`` or the distance to the map's edge
-    (computed as :func:`pathfuse.sweep.segment_static_distance` does)."""
+    (:func:`pathfuse.sweep.edge_distance`, as :func:`pathfuse.sweep.segment_static_distance`
+    takes it)."""
     half = 0.5 * math.sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay))
     lb = _field_bound(cm, 0.5 * (ax + bx), 0.5 * (ay + by))
     if not (lb - half > cap + 1e-9 * (1.0 + cap)):
         return segment_distance(cm, ax, ay, bx, by, cap, slack)
     h, w = cm.occ.shape
-    xmin = cm.ox_m
-    ymin = cm.oy_m
-    xmax = cm.ox_m + w * cm.res_m
-    ymax = cm.oy_m + h * cm.res_m
-    best = cap
-    for i in range(2):
-        px = ax if i == 0 else bx
-        py = ay if i == 0 else by
-        de = min(px - xmin, xmax - px, py - ymin, ymax - py)
-        if de < 0.0 or (de == 0.0 and slack == 0.0):
-            return 0.0
-        de += slack
-        if de < best:
-            best = de
-    return best
+    return edge_distance(cm.ox_m, cm.oy_m, cm.ox_m + w * cm.res_m, cm.oy_m + h * cm.res_m,
+                         ax, ay, bx, by, cap, slack)
 
 
 @njit(cache=True, inline="always")

@@ -135,9 +135,6 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
         help="diff-drive robot online, velocity space, while a moving disc is sensed: plan "
              "the global path again from the robot, around the sensed discs, this often "
              "(ours, as dwa; 0 = never)")
-    social_replan: bool = param(
-        True, help="ours, with social and replan_period_s: the replanned A* path keeps "
-                   "personal_m more from the sensed discs where the room allows (as dwa)")
     among_discs: str = param(
         "mppi", choices=("mppi", "window"),
         help="diff-drive robot online, velocity space, while a moving disc is sensed: track "

@@ -193,9 +193,6 @@ class MPPIParams(PersonalSpaceParams, GlobalAStarParams):
                                       help="the replanned A* path pays to come closer than "
                                            "this to an obstacle (the cost-aware A* of a safety "
                                            "margin; 0 = the plain A*)")
-    social_replan: bool = param(True, help="ours, with social: the replanned A* path keeps "
-                                           "personal_m more from the sensed discs where the "
-                                           "room allows (as dwa and the fusion)")
     stall_steps: int = param(50, ge=1, help="offline: look-back of the stall test, in ticks")
     stall_distance_m: float = param(0.05, gt=0, unit="m",
                                     help="offline: a net move below this over stall_steps "

@@ -228,6 +228,25 @@ def test_shipped_worlds_read(tmp_path):
         assert sc.grid.is_free(np.array([sc.start, sc.goal])).all()
 
 
+def test_heldout_worlds_read():
+    """The six held-out worlds (examples/irsim-heldout): one of each kind, the robot of the
+    shipped worlds, start and goal free on the rasterised map."""
+    held = EXAMPLES.parent / "irsim-heldout"
+    names = sorted(p.stem for p in held.glob("*.yaml"))
+    assert names == ["crossing_both_ways", "narrow_doorway", "overtake_two_walkers",
+                     "rvo_two_lines", "sfm_wide_flows", "vertical_head_on"]
+    kinds = set()
+    for n in names:
+        spec = read_world_spec(held / f"{n}.yaml")
+        kinds.add(spec.kind)
+        assert spec.position_m > 0 and spec.speed_frac > 0 and spec.time_limit_s >= 60
+        sc = read_scene(make_env(held / f"{n}.yaml"))
+        assert (sc.robot.kind, sc.robot.radius_m - sc.euler_margin_m, sc.robot.max_speed_mps) \
+            == ("diff-drive", 0.25, 1.0)
+        assert sc.grid.is_free(np.array([sc.start, sc.goal])).all()
+    assert len(kinds) == 6
+
+
 def test_world_spec_errors_name_the_file_and_key(tmp_path):
     bad = _world(tmp_path, BOX.replace("time_limit_s: 20", "time_limit_s: -1") + ROBOT_DIFF)
     with pytest.raises(ConfigError, match=r"w\.yaml: custom\.pathfuse\.time_limit_s"):

@@ -247,6 +247,33 @@ def test_heldout_worlds_read():
     assert len(kinds) == 6
 
 
+def test_orca_walkers_need_pyrvo(tmp_path):
+    """IR-SIM leaves ORCA walkers standing when pyrvo is missing (it only logs an error):
+    pathfuse refuses such a world, naming the key, rather than run another world."""
+    import importlib.util
+
+    text = (EXAMPLES / "rvo_crowd.yaml").read_text().replace(
+        "behavior: {name: rvo, vxmax: 1.0, vymax: 1.0, acce: 1.0, factor: 1.0, mode: rvo}",
+        "group_behavior: {name: orca}")
+    assert "group_behavior: {name: orca}" in text
+    w = tmp_path / "orca_crowd.yaml"
+    w.write_text(text)
+    if importlib.util.find_spec("pyrvo") is None:
+        with pytest.raises(ConfigError, match=r"orca_crowd\.yaml: obstacle\[0\]\."
+                                              r"group_behavior: .*pip install pyrvo"):
+            read_world_spec(w)
+        with pytest.raises(ConfigError, match=r"group_behavior 'orca' of a group of 8 .*pyrvo"):
+            make_env(w)
+    else:  # with pyrvo the walkers move
+        read_world_spec(w)
+        env = make_env(w)
+        before = np.array([o.state[:2, 0] for o in env.obstacle_list[:8]])
+        for _ in range(10):
+            env.step(np.zeros((2, 1)))
+        after = np.array([o.state[:2, 0] for o in env.obstacle_list[:8]])
+        assert np.hypot(*(after - before).T).min() > 0.1  # every walker moved
+
+
 def test_world_spec_errors_name_the_file_and_key(tmp_path):
     bad = _world(tmp_path, BOX.replace("time_limit_s: 20", "time_limit_s: -1") + ROBOT_DIFF)
     with pytest.raises(ConfigError, match=r"w\.yaml: custom\.pathfuse\.time_limit_s"):

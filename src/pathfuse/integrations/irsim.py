@@ -155,11 +155,34 @@ def make_env(world: str | os.PathLike[str], seed: int | None = None) -> Any:
         raise ConfigError(f"{p}: no such IR-SIM world file")
     try:
         with contextlib.redirect_stdout(io.StringIO()):
-            return irsim.make(str(p), display=False, headless=True, log_level="ERROR",
-                              seed=seed)
+            env = irsim.make(str(p), display=False, headless=True, log_level="ERROR",
+                             seed=seed)
     except Exception as exc:  # noqa: BLE001 - IR-SIM raises many kinds; one line names it
         raise ConfigError(f"{p}: IR-SIM cannot read this world: "
                           f"{type(exc).__name__}: {exc}") from None
+    _check_group_behaviours(env, p)
+    return env
+
+
+def _check_group_behaviours(env: Any, path: Path) -> None:
+    """Raise when a group of the world names a ``group_behavior`` that IR-SIM could not
+    start: IR-SIM logs the error and leaves the group's members standing, which would make
+    another world than the file describes (ORCA walkers without ``pyrvo``)."""
+    try:
+        from irsim.lib.behavior.behavior_registry import group_behaviors_class_map
+    except ImportError:  # another IR-SIM layout: nothing to check against
+        return
+    for group in getattr(env, "_object_groups", None) or ():
+        gb = getattr(group, "group_behavior", None)
+        name = getattr(gb, "name", None)
+        if name is None or getattr(gb, "_invoke_func", None) is not None:
+            continue
+        if (getattr(gb, "kinematics", None), name) not in group_behaviors_class_map:
+            continue
+        hint = " (IR-SIM's ORCA needs pyrvo: pip install pyrvo)" if name == "orca" else ""
+        raise ConfigError(f"{path}: group_behavior {name!r} of a group of "
+                          f"{getattr(group, 'number', '?')} objects could not start in IR-SIM"
+                          f"{hint}; without it IR-SIM would leave them standing")
 
 
 def example_worlds_dir() -> str:

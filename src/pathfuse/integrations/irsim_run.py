@@ -41,6 +41,7 @@ Examples
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 import os
@@ -154,6 +155,14 @@ def read_world_spec(path: str | os.PathLike[str]) -> WorldSpec:
         doc = dict(doc["irsim"])
     if "robot" not in doc or not doc["robot"]:
         raise ConfigError(f"{p}: robot: missing (an IR-SIM world with a robot to drive)")
+    obstacles = doc.get("obstacle") or []
+    for i, ob in enumerate(obstacles if isinstance(obstacles, list) else []):
+        gb = ob.get("group_behavior") if isinstance(ob, Mapping) else None
+        if (isinstance(gb, Mapping) and gb.get("name") == "orca"
+                and importlib.util.find_spec("pyrvo") is None):
+            raise ConfigError(f"{p}: obstacle[{i}].group_behavior: IR-SIM's ORCA walkers need "
+                              "pyrvo (pip install pyrvo); without it IR-SIM leaves them "
+                              "standing")
     custom = doc.get("custom") or {}
     block = custom.get("pathfuse") if isinstance(custom, Mapping) else None
     block = {} if block is None else block

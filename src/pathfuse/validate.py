@@ -222,6 +222,8 @@ def point(value: Any, key: str,
     x, y = value
     if type(x) is float and type(y) is float and math.isfinite(x) and math.isfinite(y):
         return x, y  # the common case, without the general checks (plan() calls this)
+    if isinstance(x, float) and isinstance(y, float) and math.isfinite(x) and math.isfinite(y):
+        return float(x), float(y)  # numpy float64 (a float subclass): what number() returns
     return (number(x, f"{key}[0]", error=error), number(y, f"{key}[1]", error=error))
 
 

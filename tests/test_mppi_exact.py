@@ -12,8 +12,8 @@ import math
 import numpy as np
 from numba import njit
 
-from pathfuse.planners.controllers.mppi_kernel import _track
 from pathfuse.field.pathing import polyline_cumlen
+from pathfuse.planners.controllers.mppi_kernel import _track
 
 
 @njit(cache=False)

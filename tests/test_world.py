@@ -343,3 +343,38 @@ def test_world_reset_replays_obstacles_and_seed_changes_random_walks():
     w.reset(seed=5)
     assert np.array_equal(b, w.obstacle_positions)
     assert not np.array_equal(a, b)
+
+
+def test_clip_action_fast_path_matches_the_general_one():
+    # a controller's float64 (2,) array skips the conversion; any other form of the same
+    # action is converted and must give the same command, bit for bit
+    for diff in (False, True):
+        robot = {"radius": 0.2, "max_speed": 1.0, "sensing_radius": 3.0}
+        if diff:
+            robot.update(model="diff-drive", heading=0.3)
+        w = _world(robot=robot)
+        w.reset()
+        for a in ((0.37, -0.21), (3.0, 4.0), (0.0, 0.0), (-1e-300, 5e-324)):
+            fast, clipped = w.clip_action(np.array(a, dtype=np.float64))
+            for other in (a, list(a), np.array([[a[0], 9.0], [a[1], 9.0]])[:, 0],
+                          np.array([a])):
+                slow, c2 = w.clip_action(other)
+                assert slow.tobytes() == fast.tobytes() and c2 == clipped
+        for bad in (np.array([np.nan, 0.0]), np.array([0.0, np.inf]), (np.inf, 0.0)):
+            with pytest.raises(QueryError, match="finite"):
+                w.clip_action(bad)
+        with pytest.raises(QueryError):
+            w.clip_action(np.zeros(3))
+
+
+def test_a_world_without_discs_senses_the_same_empty_record():
+    w = _world()
+    obs0 = w.reset()
+    obs1, *_ = w.step((0.1, 0.0))
+    s0, s1 = obs0.obstacles, obs1.obstacles
+    assert s0 is s1 and len(s0) == 0
+    # the same types as freshly made empty arrays (the kernels see one signature)
+    for got, fresh in ((s0.ids, np.zeros(0, np.int64)), (s0.positions, np.zeros((0, 2))),
+                       (s0.velocities, np.zeros((0, 2))), (s0.radii, np.zeros(0))):
+        assert got.dtype == fresh.dtype and got.shape == fresh.shape
+        assert got.flags.writeable and got.flags.c_contiguous

@@ -59,6 +59,20 @@ _NO_DISCS = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0))
 ONE_DISC = (np.array([[3.5, 0.5]]), np.array([[0.0, 0.1]]), np.array([0.2]))
 
 
+_NO_SHIELD_DISCS: Any = None
+
+
+def _no_shield_discs() -> Any:
+    """The shield's empty :class:`~pathfuse.costmap.Discs`, built once (its arrays are
+    empty: nothing in them can change)."""
+    global _NO_SHIELD_DISCS
+    if _NO_SHIELD_DISCS is None:
+        from pathfuse.costmap import Discs
+
+        _NO_SHIELD_DISCS = Discs(_NO_DISCS[0], _NO_DISCS[0], _NO_DISCS[2], _NO_DISCS[2])
+    return _NO_SHIELD_DISCS
+
+
 def _plain(a: Any) -> np.ndarray:
     """A C-contiguous writable float64 array (one numba signature for every caller)."""
     return np.require(a, dtype=np.float64, requirements=("C", "W"))
@@ -263,7 +277,7 @@ class Controller:
             dp, dr = _plain(sens.positions), _plain(sens.radii)
             discs = Discs(dp, dp, self._disc_speed_bounds(sens), dr)
         else:
-            discs = Discs(_NO_DISCS[0], _NO_DISCS[0], _NO_DISCS[2], _NO_DISCS[2])
+            discs = _no_shield_discs()
         cmd = obs.command
         dt = float(self.dt)  # type: ignore[arg-type]
         if rb.is_diff_drive:

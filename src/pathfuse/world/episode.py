@@ -358,7 +358,8 @@ def run_episode(scenario: Scenario, planner: str = "fusion", params: Any = None,
             velocities[n - 1] = obs.velocity
             commands[n - 1] = obs.command
             headings[n] = obs.heading
-            sensed[n, obs.obstacles.ids] = True
+            if k_obs:
+                sensed[n, obs.obstacles.ids] = True
             min_static = min(min_static, info["static_gap"])
             min_obst = min(min_obst, info["obstacle_gap"])
             n += 1

@@ -193,6 +193,10 @@ class World:
         self.diff_drive = self.robot.is_diff_drive
         self.goal = np.array(sc.goal, dtype=np.float64)
         self.obstacle_radii = np.array([ob.radius for ob in sc.obstacles], dtype=np.float64)
+        # without moving discs every observation senses none: one empty record serves them
+        # all (its arrays have no element to change)
+        self._none_sensed = SensedObstacles(np.zeros(0, np.int64), np.zeros((0, 2)),
+                                            np.zeros((0, 2)), np.zeros(0))
         self._tick = -1
         self._done = True
         self.seed: int | None = None
@@ -237,8 +241,7 @@ class World:
     def _sense(self) -> SensedObstacles:
         k = self._tick
         if self.obstacle_radii.shape[0] == 0:
-            return SensedObstacles(np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros((0, 2)),
-                                   np.zeros(0))
+            return self._none_sensed
         q = self.obstacle_positions[k]
         d = np.hypot(q[:, 0] - self.position[0], q[:, 1] - self.position[1]) - self.obstacle_radii
         ids = np.flatnonzero(d <= self.sensing_radius)
@@ -283,16 +286,23 @@ class World:
         change to the acceleration limit.  Diff-drive: ``(v, omega)``, each
         clipped to its limits and to its acceleration window.
         """
-        what = "(v, omega)" if self.diff_drive else "velocity (vx, vy)"
-        try:
-            v = np.asarray(action, dtype=np.float64).reshape(-1)
-        except (TypeError, ValueError):
-            raise QueryError(f"action must be a {what}, got {_shown(action)}") from None
-        if v.shape != (2,) or not np.all(np.isfinite(v)):
+        if type(action) is np.ndarray and action.dtype == np.float64 \
+                and action.shape == (2,):
+            lin, ang = float(action[0]), float(action[1])  # what the controllers return
+        else:
+            what = "(v, omega)" if self.diff_drive else "velocity (vx, vy)"
+            try:
+                v = np.asarray(action, dtype=np.float64).reshape(-1)
+            except (TypeError, ValueError):
+                raise QueryError(f"action must be a {what}, got {_shown(action)}") from None
+            if v.shape != (2,):
+                raise QueryError(f"action must be finite {what}, got {_shown(action)}")
+            lin, ang = float(v[0]), float(v[1])
+        if not (math.isfinite(lin) and math.isfinite(ang)):
+            what = "(v, omega)" if self.diff_drive else "velocity (vx, vy)"
             raise QueryError(f"action must be finite {what}, got {_shown(action)}")
         rb = self.robot
         dt = self.dt
-        lin, ang = float(v[0]), float(v[1])
         if self.diff_drive:
             a, b = clip_unicycle(float(self.command[0]), float(self.command[1]), lin, ang, dt,
                                  rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2,

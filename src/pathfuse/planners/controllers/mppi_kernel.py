@@ -196,6 +196,7 @@ def _track(px, py, pts, cum, j, k0, fwd, back):
         hi += 1
     best = j
     bd = np.inf
+    bd2 = np.inf
     bt = 0.0
     for s in range(lo, hi + 1):
         ax = pts[s, 0]
@@ -205,10 +206,25 @@ def _track(px, py, pts, cum, j, k0, fwd, back):
         l2 = vx * vx + vy * vy
         tt = 0.0
         if l2 > 0.0:
-            tt = min(max(((px - ax) * vx + (py - ay) * vy) / l2, 0.0), 1.0)
-        d = math.hypot(px - (ax + tt * vx), py - (ay + tt * vy))
+            # min(max(dot / l2, 0), 1) without the division where it clamps (exact: l2 > 0,
+            # and a correctly rounded quotient of dot >= l2 is >= 1)
+            dot = (px - ax) * vx + (py - ay) * vy
+            if dot >= l2:
+                tt = 1.0
+            elif dot > 0.0:
+                tt = min(dot / l2, 1.0)
+        ex = px - (ax + tt * vx)
+        ey = py - (ay + tt * vy)
+        # exact too: a squared distance more than 1e-12 relative above the best's square
+        # cannot give a hypot below the best (both round within some 1e-16 of the same
+        # ex, ey), so its hypot is left out
+        if ex * ex + ey * ey > bd2:
+            continue
+        d = math.hypot(ex, ey)
         if d < bd:
             bd = d
+            # (no shortcut below 1e-150 m, where the square would underflow)
+            bd2 = d * d * (1.0 + 1e-12) if d > 1e-150 else np.inf
             best = s
             bt = tt
     return best, bd, bt

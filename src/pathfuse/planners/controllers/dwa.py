@@ -114,6 +114,13 @@ from pathfuse.validate import param
 __all__ = ["DWAParams", "DWAController"]
 
 
+FIELD_CELL_M = 0.05
+"""The side (m) of the clearance lattice dwa's costmap is built with (the map's cells split up
+to 8 x 8, :func:`pathfuse.costmap.clearance_lattice`): the lattice bound loses up to a lattice
+cell's diagonal, so on a map of 1 m cells the map's own cells (1.4 m lost) let hardly a rollout
+piece skip the exact static search; the choices are the same (the shortcut is exact)."""
+
+
 @dataclass(frozen=True)
 class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
     """Parameters of ``dwa`` (the sampling, the horizon and the critics' weights)."""
@@ -254,8 +261,10 @@ class DWAController(Controller):
             if p.replan_period_s > 0 else 0
         self.ticks = 0
         self.replans = 0
-        # the map, the radius and the clearance kept (self.clear_m) in one object
-        self.costmap = costmap_for(g, float(problem.robot_radius_m))
+        # the map, the radius and the clearance kept (self.clear_m) in one object; its
+        # clearance lattice (the lower bound that lets a rollout piece skip the exact
+        # static search) split to FIELD_CELL_M, not the map's cells
+        self.costmap = costmap_for(g, float(problem.robot_radius_m), field_cell_m=FIELD_CELL_M)
         self.f = pack_dwa(
             self.tick_s, rb.min_speed_mps, rb.max_speed_mps, rb.max_accel_mps2,
             rb.max_yaw_rate_radps, rb.max_yaw_accel_radps2,

@@ -8,14 +8,17 @@ from pathfuse.costmap import costmap_for, field_distance, segment_distance
 from pathfuse.geometry import segment_box_distance
 from pathfuse.grid import GridMap
 from pathfuse.planners.controllers.dwa_checks import (
+    NO_NEAR,
+    NearSquares,
     _field_bound,
     _path_distance,
     _segment_distance,
     _straight_pose,
     _sweep_gap,
+    near_squares,
     path_blocks,
 )
-from pathfuse.sweep import disc_sweep_gaps, segment_static_distance, unicycle_pose
+from pathfuse.sweep import disc_sweep_gaps, edge_distance, segment_static_distance, unicycle_pose
 
 
 def _map() -> GridMap:
@@ -40,7 +43,7 @@ def test_segment_distance_shortcut_is_exact() -> None:
             cap = float(rng.choice([0.1, 0.3, 0.6, 1.0]))
             slack = float(rng.choice([0.0, 1e-7]))
             want = segment_distance(cm, ax, ay, bx, by, cap, slack)
-            assert _segment_distance(cm, ax, ay, bx, by, cap, slack) == want
+            assert _segment_distance(cm, ax, ay, bx, by, cap, slack, NO_NEAR) == want
             hits += want == cap
     assert hits > 1000  # the shortcut's case (nothing within the cap) was exercised
 
@@ -62,11 +65,83 @@ def test_segment_distance_under_a_smaller_cap_is_the_same_value() -> None:
             slack = float(rng.choice([0.0, 1e-7]))
             wide = float(rng.uniform(0.3, 1.0))
             narrow = float(rng.uniform(0.0, wide))
-            r1 = _segment_distance(cm, ax, ay, bx, by, wide, slack)
-            r2 = _segment_distance(cm, ax, ay, bx, by, narrow, slack)
+            r1 = _segment_distance(cm, ax, ay, bx, by, wide, slack, NO_NEAR)
+            r2 = _segment_distance(cm, ax, ay, bx, by, narrow, slack, NO_NEAR)
             assert r2 == (r1 if r1 < narrow else narrow)
             below += r1 < narrow
     assert below > 500
+
+
+def _brute(cm, ax, ay, bx, by, cap, slack):
+    """min(cap, the map's edge, every occupied square's exact distance): the search's value."""
+    h, w = cm.occ.shape
+    best = edge_distance(cm.ox_m, cm.oy_m, cm.xmax_m, cm.ymax_m, ax, ay, bx, by, cap, slack)
+    if best == 0.0:
+        return 0.0
+    res = cm.res_m
+    for rr, cc in np.argwhere(cm.occ):
+        x0 = cm.ox_m + cc * res
+        y0 = cm.oy_m + rr * res
+        best = min(best, segment_box_distance(ax, ay, bx, by, x0, y0, x0 + res, y0 + res))
+    return best
+
+
+def _near_cases(cm, rng, n):
+    """Segments up to 0.1 m long around the occupied squares, many with an end on a square's
+    edge or corner (where ties between squares are)."""
+    occ = np.argwhere(cm.occ)
+    res = cm.res_m
+    for _ in range(n):
+        rr, cc = occ[rng.integers(len(occ))]
+        ax = cm.ox_m + (cc + rng.choice([rng.uniform(-3, 4), 0.0, 1.0])) * res
+        ay = cm.oy_m + (rr + rng.choice([rng.uniform(-3, 4), 0.0, 1.0])) * res
+        length = float(rng.choice([0.0, 0.01, 0.05, 0.1]))
+        a = rng.choice([rng.uniform(0.0, 2.0 * np.pi), 0.0, 0.5 * np.pi, 0.25 * np.pi])
+        yield ax, ay, ax + length * np.cos(a), ay + length * np.sin(a)
+
+
+def _near_mismatches(cm, near, seed, n):
+    rng = np.random.default_rng(seed)
+    used = bad = 0
+    for ax, ay, bx, by in _near_cases(cm, rng, n):
+        cap = float(rng.choice([0.05, 0.3, 0.6, 1.2]))
+        slack = float(rng.choice([0.0, 1e-7]))
+        got = _segment_distance(cm, ax, ay, bx, by, cap, slack, near)
+        want = segment_distance(cm, ax, ay, bx, by, cap, slack)
+        assert want == _brute(cm, ax, ay, bx, by, cap, slack)
+        bad += got != want
+        used += want < cap
+    return bad, used
+
+
+def test_near_squares_give_the_searched_distance() -> None:
+    # dwa's near-square lists (dwa_checks.near_squares) stand for the search of the squares:
+    # the same value bit for bit, on a map of 0.1 m cells and on 1 m cells split 20 x 20
+    # (as dwa's costmap, field_cell_m 0.05), against the search and a brute force
+    g = _map()
+    rng = np.random.default_rng(7)
+    occ = rng.random((12, 15)) < 0.15
+    g1 = GridMap(occ, origin=(0.5, -2.0), resolution=1.0)
+    for grid, cell in ((g, None), (g, 0.05), (g1, 0.05)):
+        for radius in (0.1, 0.333):
+            cm = costmap_for(grid, radius, field_cell_m=cell)
+            near = near_squares(cm, cm.field_res_m * np.sqrt(0.5) + 0.06, 2.0)
+            assert near.sq.shape[0] > 0
+            bad, used = _near_mismatches(cm, near, 11, 1500)
+            assert bad == 0
+            assert used > 300  # squares within the cap: the lists decided
+
+
+def test_near_squares_test_fails_when_the_lists_are_short() -> None:
+    # the test above can fail: lists that keep only each cell's first square
+    g = GridMap(np.random.default_rng(7).random((12, 15)) < 0.15, origin=(0.5, -2.0),
+                resolution=1.0)
+    cm = costmap_for(g, 0.1, field_cell_m=0.05)
+    near = near_squares(cm, cm.field_res_m * np.sqrt(0.5) + 0.06, 2.0)
+    start = near.start.copy()
+    start[1::2] = np.minimum(start[0::2] + 1, start[1::2])
+    bad, _ = _near_mismatches(cm, NearSquares(start, near.sq, near.reach_m), 11, 1500)
+    assert bad > 20
 
 
 def test_sweep_gap_is_disc_sweep_gaps() -> None:

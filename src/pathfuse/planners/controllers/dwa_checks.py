@@ -8,15 +8,94 @@ call, and no search of the squares when the clearance lattice rules them out.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from pathfuse.costmap import segment_distance
+from pathfuse.geometry import point_box_distance, segment_box_distance
 from pathfuse.sweep import edge_distance
 
-__all__ = ["BLOCK", "_path_distance", "_segment_distance", "_straight_pose", "_sweep_gap",
-           "path_blocks"]
+__all__ = ["BLOCK", "NearSquares", "NO_NEAR", "near_squares", "_path_distance",
+           "_segment_distance", "_straight_pose", "_sweep_gap", "path_blocks"]
+
+
+class NearSquares(NamedTuple):
+    """Per clearance-lattice cell of a costmap, the occupied squares that can be the nearest
+    to a segment near the cell (:func:`near_squares`): ``sq[start[2 i]:start[2 i + 1]]``
+    (squares ``row * W + col``) for lattice cell ``i = q * Ws + c`` when ``start[2 i] >= 0``
+    (``-1``: no list, the cell's lattice bound is beyond ``dmax_m``); a segment whose points
+    are all within ``reach_m`` of the cell's centre is nearest to one of them (or to none
+    nearer than the cell's nearest square plus ``2 reach_m``... see :func:`near_squares`)."""
+
+    start: np.ndarray
+    sq: np.ndarray
+    reach_m: float
+
+
+NO_NEAR = NearSquares(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0.0)
+"""No lists: :func:`_segment_distance` searches the squares every time."""
+
+
+@njit(cache=True)
+def _near_lists(occ, ox, oy, res, field, fres, reach, dmax):
+    h, w = occ.shape
+    hs, ws = field.shape
+    half_diag = fres * math.sqrt(0.5)
+    start = np.full(2 * hs * ws, -1, dtype=np.int64)
+    cap = 1024
+    sq = np.empty(cap, dtype=np.int64)
+    n = 0
+    for q in range(hs):
+        cy = oy + (q + 0.5) * fres
+        for c in range(ws):
+            i = q * ws + c
+            # the distance from the centre to its nearest square is at most the lattice's
+            # lower bound plus a lattice cell's diagonal (field = EDT - half a diagonal)
+            up = field[q, c] + 2.0 * half_diag
+            if not (up <= dmax):
+                continue
+            cx = ox + (c + 0.5) * fres
+            # a segment within reach of the centre is at most up + reach from a square, so its
+            # nearest square is at most up + 2 reach from the centre (with room for rounding)
+            lim = up + 2.0 * reach + 1e-6 * (1.0 + up + abs(cx) + abs(cy))
+            c0 = max(int(math.floor((cx - lim - ox) / res)), 0)
+            c1 = min(int(math.floor((cx + lim - ox) / res)), w - 1)
+            r0 = max(int(math.floor((cy - lim - oy) / res)), 0)
+            r1 = min(int(math.floor((cy + lim - oy) / res)), h - 1)
+            start[2 * i] = n
+            for rr in range(r0, r1 + 1):
+                for cc in range(c0, c1 + 1):
+                    if occ[rr, cc]:
+                        x0 = ox + cc * res
+                        y0 = oy + rr * res
+                        if point_box_distance(cx, cy, x0, y0, x0 + res, y0 + res) <= lim:
+                            if n == cap:
+                                cap *= 2
+                                grown = np.empty(cap, dtype=np.int64)
+                                grown[:n] = sq[:n]
+                                sq = grown
+                            sq[n] = rr * w + cc
+                            n += 1
+            start[2 * i + 1] = n
+    return start, sq[:n].copy()
+
+
+def near_squares(cm, reach_m: float, dmax_m: float,
+                 max_entries: int = 20_000_000) -> NearSquares:
+    """The squares near each lattice cell of the costmap ``cm`` (:class:`NearSquares`), for
+    segments within ``reach_m`` of a cell's centre, on the cells whose lattice bound is at
+    most ``dmax_m`` (farther ones are left to the lattice shortcut or the search); ``NO_NEAR``
+    when the lists would exceed ``max_entries`` squares or the costmap has no lattice."""
+    hs, ws = cm.field.shape
+    if hs * ws <= 1 or hs * ws > max_entries:
+        return NO_NEAR
+    start, sq = _near_lists(cm.occ, cm.ox_m, cm.oy_m, cm.res_m, cm.field, cm.field_res_m,
+                            float(reach_m), float(dmax_m))
+    if sq.shape[0] > max_entries:
+        return NO_NEAR
+    return NearSquares(start, sq, float(reach_m))
 
 
 @njit(cache=True, inline="always")
@@ -56,21 +135,54 @@ def _field_bound(cm, x, y):
 
 
 @njit(cache=True, inline="always")
-def _segment_distance(cm, ax, ay, bx, by, cap, slack):
+def _segment_distance(cm, ax, ay, bx, by, cap, slack, near):
     """:func:`pathfuse.costmap.segment_distance`, the same value, with an exact shortcut:
     when the costmap's clearance lattice (a lower bound of the distance to the occupied
     squares, :func:`pathfuse.costmap.field_distance`, at the segment's midpoint less half
     its length) puts every square beyond ``cap`` (with 1e-9 to spare for rounding), no
     square can lower the result, which is then ``cap`` or the distance to the map's edge
     (:func:`pathfuse.sweep.edge_distance`, as :func:`pathfuse.sweep.segment_static_distance`
-    takes it)."""
+    takes it).
+
+    Otherwise, with the lists ``near`` (:func:`near_squares`), when the segment lies within
+    their reach of its midpoint's lattice cell, the least distance over the cell's list
+    (the same squares' exact distances as the search's, so the same value); else the
+    search."""
     half = 0.5 * math.sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay))
-    lb = _field_bound(cm, 0.5 * (ax + bx), 0.5 * (ay + by))
-    if not (lb - half > cap + 1e-9 * (1.0 + cap)):
-        return segment_distance(cm, ax, ay, bx, by, cap, slack)
+    mx = 0.5 * (ax + bx)
+    my = 0.5 * (ay + by)
+    lb = _field_bound(cm, mx, my)
     h, w = cm.occ.shape
-    return edge_distance(cm.ox_m, cm.oy_m, cm.ox_m + w * cm.res_m, cm.oy_m + h * cm.res_m,
-                         ax, ay, bx, by, cap, slack)
+    if lb - half > cap + 1e-9 * (1.0 + cap):
+        return edge_distance(cm.ox_m, cm.oy_m, cm.ox_m + w * cm.res_m,
+                             cm.oy_m + h * cm.res_m, ax, ay, bx, by, cap, slack)
+    if near.start.shape[0] > 0:
+        r = cm.field_res_m
+        hs, ws = cm.field.shape
+        c = int(math.floor((mx - cm.ox_m) / r))
+        q = int(math.floor((my - cm.oy_m) / r))
+        if 0 <= c < ws and 0 <= q < hs:
+            i = q * ws + c
+            s0 = near.start[2 * i]
+            ex = mx - (cm.ox_m + (c + 0.5) * r)
+            ey = my - (cm.oy_m + (q + 0.5) * r)
+            if s0 >= 0 and math.sqrt(ex * ex + ey * ey) + half <= near.reach_m * (1.0 - 1e-9):
+                best = edge_distance(cm.ox_m, cm.oy_m, cm.ox_m + w * cm.res_m,
+                                     cm.oy_m + h * cm.res_m, ax, ay, bx, by, cap, slack)
+                if best == 0.0:
+                    return 0.0
+                res = cm.res_m
+                for j in range(s0, near.start[2 * i + 1]):
+                    sq = near.sq[j]
+                    rr = sq // w
+                    cc = sq - rr * w
+                    x0 = cm.ox_m + cc * res
+                    y0 = cm.oy_m + rr * res
+                    d = segment_box_distance(ax, ay, bx, by, x0, y0, x0 + res, y0 + res)
+                    if d < best:
+                        best = d
+                return best
+    return segment_distance(cm, ax, ay, bx, by, cap, slack)
 
 
 @njit(cache=True, inline="always")

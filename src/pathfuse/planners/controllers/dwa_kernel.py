@@ -20,6 +20,7 @@ from numba import njit
 from pathfuse.costmap import Discs, segment_distance
 from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.controllers.dwa_checks import (
+    NearSquares,
     _path_distance,
     _segment_distance,
     _straight_pose,
@@ -30,8 +31,8 @@ from pathfuse.planners.controllers.social import EVERY_DISC, dwell_shortfall
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
 from pathfuse.sweep import arc_deviation_bound, unicycle_pose
 
-__all__ = ["dwa_choose", "dwa_progress", "pack_dwa", "path_gap", "relaxed", "dwa_tick",
-           "keep_reference", "route_tangent", "DwaSettings", "DwaTick"]
+__all__ = ["dwa_choose", "dwa_choose_near", "dwa_progress", "pack_dwa", "path_gap", "relaxed",
+           "dwa_tick", "keep_reference", "route_tangent", "DwaSettings", "DwaTick"]
 
 SOFT = 0.3
 KEEP_FLOOR = 0.02
@@ -223,13 +224,14 @@ def path_gap(cm, s, pts, cum, k, length):
 # would be computed again for each of the v_samples x w_samples commands per tick.  The
 # geometry is in helpers (dwa_checks, _path_distance, dwell_shortfall).
 @njit(cache=True)
-def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel, drad, out,
-             tx, ty, dside, sides, reach, steady):
+def _rollout(cm, nsq, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel, drad,
+             out, tx, ty, dside, sides, reach, steady):
     """Score one sample: ``out = [cost, admissible, first_tick_clear]``; ``sides[j] = (side,
     least predicted gap)`` of the sample against sensed disc ``j`` (the social critics,
     :mod:`pathfuse.planners.controllers.social`; ``(tx, ty)`` the route's direction);
     ``reach`` is scratch space of one float per disc (allocated once per tick); ``bb`` the
-    path's segment blocks ``k .. jg`` (:func:`path_blocks`, once per tick)."""
+    path's segment blocks ``k .. jg`` (:func:`path_blocks`, once per tick); ``nsq`` the
+    squares near each lattice cell (:func:`.dwa_checks.near_squares`, or none)."""
     res = cm.res_m
     dt = f.dt_s
     radius = cm.radius_m
@@ -291,14 +293,14 @@ def _rollout(cm, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel
         # changes nothing, and a nearer one is found at the same distance, bit for bit
         lo = max(clear, dmin, dnear if t <= near + 1e-12 else clear) + e
         d = _segment_distance(cm, ax, ay, bx, by, min(cap, lo + 1e-12 * (1.0 + lo)),
-                              slack) - e
+                              slack, nsq) - e
         if t <= dt + 1e-12:
             # the tick itself: the arc (lower bound) and the chord (the path offline) clear
             if d < clear:
                 first_ok = False
                 ok = False
                 break
-            if e > 0.0 and _segment_distance(cm, ax, ay, bx, by, clear, slack) < clear:
+            if e > 0.0 and _segment_distance(cm, ax, ay, bx, by, clear, slack, nsq) < clear:
                 first_ok = False
                 ok = False
                 break
@@ -445,6 +447,16 @@ def _passive_penalty(gap):
 
 @njit(cache=True)
 def dwa_choose(cm, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chosen):
+    """:func:`dwa_choose_near` without the near squares' lists (the same choice, with a
+    search of the squares wherever the lattice cannot rule them out)."""
+    none = NearSquares(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0.0)
+    return dwa_choose_near(cm, none, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
+                           dside, chosen)
+
+
+@njit(cache=True)
+def dwa_choose_near(cm, near, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside,
+                    chosen):
     """The best command from the dynamic window.
 
     ``dside`` holds the committed passing side of each sensed disc (+1, -1, 0: none) and
@@ -452,7 +464,9 @@ def dwa_choose(cm, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dsi
     (:mod:`pathfuse.planners.controllers.social`); the side is told against the route direction
     ``tick.route_x, tick.route_y`` (:func:`dwa_tick`), or the path's at ``k`` when that is
     zero.  ``cm`` is the static map with the robot's radius and clearance, ``f`` the
-    :class:`DwaSettings`.
+    :class:`DwaSettings`, ``near`` the squares near each cell of ``cm``'s lattice
+    (:func:`~pathfuse.planners.controllers.dwa_checks.near_squares`: the same choice as
+    without them, found faster).
 
     ``(c0, c1)`` is the last command: ``(v, omega)`` for a diff-drive robot,
     ``(vx, vy)`` for a holonomic one.  Returns ``(a0, a1, admissible_count,
@@ -470,25 +484,25 @@ def dwa_choose(cm, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dsi
         # keep the margin, or at least half of it where the robot still has that much
         hi = clear + min(margin, max(d - clear, 0.5 * margin)) * (1.0 - 1e-9)
         if hi > clear:
-            a0, a1, count, best = _choose(cm, f, hi, tick, x, y, th, c0, c1, pts, cum, k,
+            a0, a1, count, best = _choose(cm, near, f, hi, tick, x, y, th, c0, c1, pts, cum, k,
                                           dpos, dvel, drad, dside, chosen)
             if count > 0:
                 return a0, a1, count, best
-    a0, a1, count, best = _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos,
-                                  dvel, drad, dside, chosen)
+    a0, a1, count, best = _choose(cm, near, f, clear, tick, x, y, th, c0, c1, pts, cum, k,
+                                  dpos, dvel, drad, dside, chosen)
     if count == 0 and f.inside_clear:
         # ours: a robot already inside its own clearance (IR-SIM's Euler step or a push put
         # it there) finds no sample keeping ``clear``; the samples that keep the gap it has
         # (moving along the obstacle or away from it) are admissible instead
         d = segment_distance(cm, x, y, x, y, clear, MARGIN_FRAC * cm.res_m)
         if d < clear:
-            a0, a1, count, best = _choose(cm, f, d * (1.0 - 1e-9), tick, x, y, th, c0, c1, pts,
-                                          cum, k, dpos, dvel, drad, dside, chosen)
+            a0, a1, count, best = _choose(cm, near, f, d * (1.0 - 1e-9), tick, x, y, th, c0,
+                                          c1, pts, cum, k, dpos, dvel, drad, dside, chosen)
     return a0, a1, count, best
 
 
 @njit(cache=True)
-def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside,
+def _choose(cm, near, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside,
             chosen):
     dt = f.dt_s
     vmax = f.max_speed_mps
@@ -541,8 +555,8 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                             uy *= vmax / sn * (1.0 - 1e-12)
                 sp = math.hypot(ux, uy)
                 hd = math.atan2(uy, ux) if sp > 0.0 else th
-                _rollout(cm, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg, bb,
-                         dpos, dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
+                _rollout(cm, near, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg,
+                         bb, dpos, dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
                 if out[1] == 1.0 and n_disc > 0:
                     out[0] += _passive_penalty(holonomic_stop_disc_gap(
                         x, y, ux, uy, dt, amax, cm.radius_m, discs))
@@ -572,8 +586,8 @@ def _choose(cm, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                                                 whi)
             else:
                 w = min(max(0.0, wlo), whi)  # always try going straight
-            _rollout(cm, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, bb, dpos,
-                     dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
+            _rollout(cm, near, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, bb,
+                     dpos, dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
             if out[1] == 1.0 and n_disc > 0:
                 out[0] += _passive_penalty(unicycle_stop_disc_gap(
                     x, y, th, v, w, dt, amax, f.max_yaw_accel_radps2, cm.radius_m, discs))

@@ -86,6 +86,33 @@ with it, never at fault either way (the shield still enforces passive safety).""
 
 
 
+def crosses_lane(line: np.ndarray, dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray,
+                 lane_s: float, radius: float) -> bool:
+    """Whether a point of ``line`` after its first lies within ``radius + drad[i]`` of the
+    lane disc ``i`` sweeps at constant velocity over ``lane_s`` seconds (ours, the fusion's
+    ``replan_lane_s``), the robot's own point aside.
+
+    >>> line = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    >>> crosses_lane(line, np.array([[5.0, 0.3]]), np.array([[-1.0, 0.0]]), np.array([0.25]),
+    ...              3.0, 0.25)
+    True
+    >>> crosses_lane(line, np.array([[5.0, 1.0]]), np.array([[-1.0, 0.0]]), np.array([0.25]),
+    ...              3.0, 0.25)
+    False
+    """
+    for i in range(drad.shape[0]):
+        ax, ay = float(dpos[i, 0]), float(dpos[i, 1])
+        bx, by = float(dvel[i, 0]) * lane_s, float(dvel[i, 1]) * lane_s
+        l2 = bx * bx + by * by
+        reach = radius + float(drad[i])
+        for j in range(1, line.shape[0]):
+            qx, qy = float(line[j, 0]) - ax, float(line[j, 1]) - ay
+            u = min(1.0, max(0.0, (qx * bx + qy * by) / l2)) if l2 > 0.0 else 0.0
+            if math.hypot(qx - u * bx, qy - u * by) < reach:
+                return True
+    return False
+
+
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
@@ -151,6 +178,8 @@ class ForceWindow:
         self.on_line = 0
         """Ticks scored against Algorithm 2's local path (the rest: against the A* path)."""
         self.on_path = 0
+        self.lane_ticks = 0
+        """Ticks the A* path led because the local path walked into a disc's lane."""
         self.look_m = float(p.lookahead_m)
         self.rotate_rad = math.pi / 3.0
         """Beyond this bearing of the local path (``look_m`` along it) the robot first turns
@@ -247,6 +276,15 @@ class ForceWindow:
                                               self.recover_k, 2.0))
             pts, cum, k = self.rec_pts, self.rec_cum, self.recover_k
             net = -1.0
+        lane_s = float(getattr(self.social, "replan_lane_s", 0.0)) if self.social.social \
+            else 0.0
+        if lane_s > 0.0 and drad.shape[0] and net >= 0.0 \
+                and crosses_lane(local, dpos, dvel, drad, lane_s,
+                                 float(self.problem.robot_radius_m)):
+            # ours (replan_lane_s): Algorithm 2's local path walks into a sensed disc's lane;
+            # the A* path, replanned out of the lanes, leads instead
+            net = -1.0
+            self.lane_ticks += 1
         if local.shape[0] >= 2 and net >= self.min_reach_m:
             path, pcum, kk = np.require(local, np.float64, ("C", "W")), lc, 0
             self.on_line += 1

@@ -47,6 +47,15 @@ sensed discs every ``replan_period_s`` (:mod:`pathfuse.planners.controllers.repl
 as ``dwa`` does), so the A* points that attract the robot lead around them.
 Without discs nothing of this runs: the static results (BARN) do not change.
 
+Out of walkers' lanes (ours, ``replan_lane_s``, 3 s by default; issue 18): that A* path is
+first planned with each sensed disc's lane blocked too, the ground it sweeps at constant
+velocity over the next ``replan_lane_s`` (:func:`pathfuse.planners.controllers.replan.lane_discs`),
+and while Algorithm 2's local path walks into such a lane (:func:`crosses_lane`) the
+sequences track the A* path instead: Algorithm 2's goal attraction led the robot on down a
+walker's lane, MPPI's 2.5 s rollouts saw the walker too late to cross and the robot fled
+ahead of walkers faster than itself.  A disc first sensed is replanned around at once
+(``replan_new``), not up to ``replan_period_s`` later.
+
 Recovery (ours): when the robot has moved less than 0.3 m in 3 s, A* is
 planned again from where it stands and followed for 4 s, then Algorithm 2
 resumes (the escape of Algorithm 2 backs out along the walked trail, which a
@@ -76,7 +85,7 @@ from pathfuse.planners.controllers.dwa_kernel import (
 )
 from pathfuse.planners.controllers.social import PassingSides, SteadyDiscs, disc_ids
 
-__all__ = ["ForceWindow", "PASSIVE_WINDOW"]
+__all__ = ["ForceWindow", "PASSIVE_WINDOW", "crosses_lane"]
 
 PASSIVE_WINDOW = False
 """Whether the window plans for the shield's passive safety as ``dwa`` does by default

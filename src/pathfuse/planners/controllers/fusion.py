@@ -152,7 +152,8 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
     replan_lane_s: float = param(
         3.0, ge=0, le=30, unit="s",
         help="ours, with social (diff-drive robot online, velocity space): the replanned A* "
-             "path first keeps out of the lane each sensed disc sweeps at constant velocity "
+             "path first keeps out of the lane each sensed disc (not seen to wander: "
+             "sensed for 1 s and not steady) sweeps at constant velocity "
              "over the next replan_lane_s (grown by personal_m where social_replan), so the "
              "robot leaves a walker's lane before the walker comes rather than fleeing "
              "ahead of it; where no such path exists, as before; 0 = off")
@@ -259,7 +260,7 @@ class FusionController(FieldController):
         pts = replan_around_discs(self.problem, float(obs.position[0]),
                                   float(obs.position[1]), dpos, drad, p,
                                   personal_m=p.personal_m if p.social and p.social_replan
-                                  else 0.0, dvel=dvel,
+                                  else 0.0, dvel=self._window.lane_velocities(obs, dvel),
                                   lane_s=p.replan_lane_s if p.social else 0.0)
         self.replans += 1
         if pts is None:

@@ -288,7 +288,7 @@ class ForceWindow:
         lane_s = float(getattr(self.social, "replan_lane_s", 0.0)) if self.social.social \
             else 0.0
         if lane_s > 0.0 and drad.shape[0] and net >= 0.0 \
-                and crosses_lane(local, dpos, dvel, drad, lane_s,
+                and crosses_lane(local, dpos, self.lane_velocities(obs, dvel), drad, lane_s,
                                  float(self.problem.robot_radius_m)):
             # ours (replan_lane_s): Algorithm 2's local path walks into a sensed disc's lane;
             # the A* path, replanned out of the lanes, leads instead
@@ -335,6 +335,14 @@ class ForceWindow:
             # would spin past it)
             return self._rotate(err)
         return np.array([float(a0), float(a1)])
+
+    def lane_velocities(self, obs: Any, dvel: np.ndarray) -> np.ndarray:
+        """The sensed discs' velocities, 0 for those seen to wander (sensed for a second and
+        not steady, :class:`~pathfuse.planners.controllers.social.SteadyDiscs`): the lanes
+        of ``replan_lane_s`` are those of the discs that may keep their velocity (ours)."""
+        ids = disc_ids(obs, dvel.shape[0])
+        keep = np.array([int(i) not in self.steady.wanders for i in ids], dtype=np.float64)
+        return np.ascontiguousarray(dvel * keep[:, None]) if keep.size else dvel
 
     def _sequences(self, obs: Any, path: np.ndarray, kk: int, pts: np.ndarray, k: int,
                    dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray) -> np.ndarray:

@@ -448,11 +448,13 @@ def test_fusion_replans_with_personal_space_around_a_head_on_pair():
     """social_replan (ours, as dwa's): after passing the first pair low the fusion stood in
     the second pair's lane, turned to flee ahead of them and was walked into
     (corridor_head_on, seed 6); with the replanned path keeping personal_m from the people
-    it passes both pairs."""
+    it passes both pairs.  (The lanes of replan_lane_s, and replan_new, avoid it too: both
+    off here.)"""
     world = Path(example_worlds_dir()) / "corridor_head_on.yaml"
-    ep = run_irsim_episode(world, "fusion", 6, {"seed": 6})
+    before = {"seed": 6, "replan_lane_s": 0.0, "replan_new": False}
+    ep = run_irsim_episode(world, "fusion", 6, before)
     assert ep.status.name == "SUCCESS" and ep.social.min_gap_m > 0.3
-    off = run_irsim_episode(world, "fusion", 6, {"seed": 6, "social_replan": False})
+    off = run_irsim_episode(world, "fusion", 6, {**before, "social_replan": False})
     assert off.status.name == "COLLISION" and off.collision_with == "person"
 
 
@@ -465,4 +467,18 @@ def test_mppi_replans_with_personal_space_around_a_head_on_pair():
     ep = run_irsim_episode(world, "mppi", 1, {"seed": 1})
     assert ep.status.name == "SUCCESS"
     off = run_irsim_episode(world, "mppi", 1, {"seed": 1, "social_replan": False})
+    assert off.status.name == "COLLISION" and off.collision_with == "person"
+
+
+def test_fusion_leaves_the_lane_of_a_head_on_pair_rather_than_fleeing():
+    """replan_lane_s (ours): after passing the first pair low the fusion sensed the second
+    pair 5 m away, in their lane; Algorithm 2's local path led on into it, the robot slowed,
+    turned round and fled ahead of walkers faster than itself, and was walked into
+    (corridor_head_on, seed 3).  With the replanned A* path keeping out of the walkers'
+    lanes over the next 3 s, and leading while the local path walks into one, it crosses
+    to the free side in time."""
+    world = Path(example_worlds_dir()) / "corridor_head_on.yaml"
+    ep = run_irsim_episode(world, "fusion", 3, {"seed": 3})
+    assert ep.status.name == "SUCCESS" and ep.social.min_gap_m > 0.3
+    off = run_irsim_episode(world, "fusion", 3, {"seed": 3, "replan_lane_s": 0.0})
     assert off.status.name == "COLLISION" and off.collision_with == "person"

@@ -89,6 +89,7 @@ from pathfuse.field.settings import pack_fusion
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController, sensed_discs
 from pathfuse.planners.controllers.replan import replan_around_discs
+from pathfuse.planners.controllers.social import disc_ids
 from pathfuse.planners.params import (
     DiscParams,
     FieldParams,
@@ -148,6 +149,17 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                                 "a steady sensed disc (one that kept its velocity for 1 s), "
                                 "predicted at constant velocity, sweeps in the "
                                 "dwell_s after the rollout; 0 = off (the default of mppi)")
+    replan_lane_s: float = param(
+        3.0, ge=0, le=30, unit="s",
+        help="ours, with social (diff-drive robot online, velocity space): the replanned A* "
+             "path first keeps out of the lane each sensed disc (not seen to wander: "
+             "sensed for 1 s and not steady) sweeps at constant velocity "
+             "over the next replan_lane_s (grown by personal_m where social_replan), so the "
+             "robot leaves a walker's lane before the walker comes rather than fleeing "
+             "ahead of it; where no such path exists, as before; 0 = off")
+    replan_new: bool = param(
+        True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
+                   "soon as it is first sensed, not up to replan_period_s later; false = off")
     velocity_space: bool = param(True, help="diff-drive robot online: choose (v, omega) from "
                                             "the dynamic window by agreement with Algorithm "
                                             "2's move, clearance and the predicted discs "
@@ -196,6 +208,7 @@ class FusionController(FieldController):
             self._window = ForceWindow(problem, float(self.dt),  # type: ignore[arg-type]
                                        social=p, among_discs=p.among_discs, seed=p.seed)
         self._ticks = 0
+        self._seen: set[int] = set()
         self.replans = 0
         self._replan_every = 0
         if self._window is not None and p.replan_period_s > 0:
@@ -231,15 +244,24 @@ class FusionController(FieldController):
         that attract the robot then lead around them).  Not during an escape, whose target
         indices refer to the path it started on."""
         self._ticks += 1
-        dpos, _, drad = sensed_discs(obs)
-        if not (drad.shape[0] and self._replan_every and self._ticks % self._replan_every == 0
+        dpos, dvel, drad = sensed_discs(obs)
+        p = self.params
+        new_disc = False
+        if p.replan_new and drad.shape[0]:
+            # ours (replan_new): a disc sensed for the first time is replanned around now,
+            # not up to replan_period_s later
+            seen = {int(i) for i in disc_ids(obs, drad.shape[0])}
+            new_disc = bool(seen - self._seen)
+            self._seen = seen
+        if not (drad.shape[0] and self._replan_every
+                and (new_disc or self._ticks % self._replan_every == 0)
                 and int(self.state[S_MODE]) == 0):
             return
-        p = self.params
         pts = replan_around_discs(self.problem, float(obs.position[0]),
                                   float(obs.position[1]), dpos, drad, p,
                                   personal_m=p.personal_m if p.social and p.social_replan
-                                  else 0.0)
+                                  else 0.0, dvel=self._window.lane_velocities(obs, dvel),
+                                  lane_s=p.replan_lane_s if p.social else 0.0)
         self.replans += 1
         if pts is None:
             return

@@ -47,6 +47,15 @@ sensed discs every ``replan_period_s`` (:mod:`pathfuse.planners.controllers.repl
 as ``dwa`` does), so the A* points that attract the robot lead around them.
 Without discs nothing of this runs: the static results (BARN) do not change.
 
+Out of walkers' lanes (ours, ``replan_lane_s``, 3 s by default; issue 18): that A* path is
+first planned with each sensed disc's lane blocked too, the ground it sweeps at constant
+velocity over the next ``replan_lane_s`` (:func:`pathfuse.planners.controllers.replan.lane_discs`),
+and while Algorithm 2's local path walks into such a lane (:func:`crosses_lane`) the
+sequences track the A* path instead: Algorithm 2's goal attraction led the robot on down a
+walker's lane, MPPI's 2.5 s rollouts saw the walker too late to cross and the robot fled
+ahead of walkers faster than itself.  A disc first sensed is replanned around at once
+(``replan_new``), not up to ``replan_period_s`` later.
+
 Recovery (ours): when the robot has moved less than 0.3 m in 3 s, A* is
 planned again from where it stands and followed for 4 s, then Algorithm 2
 resumes (the escape of Algorithm 2 backs out along the walked trail, which a
@@ -76,7 +85,7 @@ from pathfuse.planners.controllers.dwa_kernel import (
 )
 from pathfuse.planners.controllers.social import PassingSides, SteadyDiscs, disc_ids
 
-__all__ = ["ForceWindow", "PASSIVE_WINDOW"]
+__all__ = ["ForceWindow", "PASSIVE_WINDOW", "crosses_lane"]
 
 PASSIVE_WINDOW = False
 """Whether the window plans for the shield's passive safety as ``dwa`` does by default
@@ -84,6 +93,33 @@ PASSIVE_WINDOW = False
 scenarios) the fusion reached 84/70/54/18 % with 0/2/4/8 discs without it and 84/70/38/14 %
 with it, never at fault either way (the shield still enforces passive safety)."""
 
+
+
+def crosses_lane(line: np.ndarray, dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray,
+                 lane_s: float, radius: float) -> bool:
+    """Whether a point of ``line`` after its first lies within ``radius + drad[i]`` of the
+    lane disc ``i`` sweeps at constant velocity over ``lane_s`` seconds (ours, the fusion's
+    ``replan_lane_s``), the robot's own point aside.
+
+    >>> line = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    >>> crosses_lane(line, np.array([[5.0, 0.3]]), np.array([[-1.0, 0.0]]), np.array([0.25]),
+    ...              3.0, 0.25)
+    True
+    >>> crosses_lane(line, np.array([[5.0, 1.0]]), np.array([[-1.0, 0.0]]), np.array([0.25]),
+    ...              3.0, 0.25)
+    False
+    """
+    for i in range(drad.shape[0]):
+        ax, ay = float(dpos[i, 0]), float(dpos[i, 1])
+        bx, by = float(dvel[i, 0]) * lane_s, float(dvel[i, 1]) * lane_s
+        l2 = bx * bx + by * by
+        reach = radius + float(drad[i])
+        for j in range(1, line.shape[0]):
+            qx, qy = float(line[j, 0]) - ax, float(line[j, 1]) - ay
+            u = min(1.0, max(0.0, (qx * bx + qy * by) / l2)) if l2 > 0.0 else 0.0
+            if math.hypot(qx - u * bx, qy - u * by) < reach:
+                return True
+    return False
 
 
 def _wrap(a: float) -> float:
@@ -151,6 +187,8 @@ class ForceWindow:
         self.on_line = 0
         """Ticks scored against Algorithm 2's local path (the rest: against the A* path)."""
         self.on_path = 0
+        self.lane_ticks = 0
+        """Ticks the A* path led because the local path walked into a disc's lane."""
         self.look_m = float(p.lookahead_m)
         self.rotate_rad = math.pi / 3.0
         """Beyond this bearing of the local path (``look_m`` along it) the robot first turns
@@ -247,6 +285,15 @@ class ForceWindow:
                                               self.recover_k, 2.0))
             pts, cum, k = self.rec_pts, self.rec_cum, self.recover_k
             net = -1.0
+        lane_s = float(getattr(self.social, "replan_lane_s", 0.0)) if self.social.social \
+            else 0.0
+        if lane_s > 0.0 and drad.shape[0] and net >= 0.0 \
+                and crosses_lane(local, dpos, self.lane_velocities(obs, dvel), drad, lane_s,
+                                 float(self.problem.robot_radius_m)):
+            # ours (replan_lane_s): Algorithm 2's local path walks into a sensed disc's lane;
+            # the A* path, replanned out of the lanes, leads instead
+            net = -1.0
+            self.lane_ticks += 1
         if local.shape[0] >= 2 and net >= self.min_reach_m:
             path, pcum, kk = np.require(local, np.float64, ("C", "W")), lc, 0
             self.on_line += 1
@@ -288,6 +335,14 @@ class ForceWindow:
             # would spin past it)
             return self._rotate(err)
         return np.array([float(a0), float(a1)])
+
+    def lane_velocities(self, obs: Any, dvel: np.ndarray) -> np.ndarray:
+        """The sensed discs' velocities, 0 for those seen to wander (sensed for a second and
+        not steady, :class:`~pathfuse.planners.controllers.social.SteadyDiscs`): the lanes
+        of ``replan_lane_s`` are those of the discs that may keep their velocity (ours)."""
+        ids = disc_ids(obs, dvel.shape[0])
+        keep = np.array([int(i) not in self.steady.wanders for i in ids], dtype=np.float64)
+        return np.ascontiguousarray(dvel * keep[:, None]) if keep.size else dvel
 
     def _sequences(self, obs: Any, path: np.ndarray, kk: int, pts: np.ndarray, k: int,
                    dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray) -> np.ndarray:

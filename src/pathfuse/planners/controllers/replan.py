@@ -19,13 +19,14 @@ import numpy as np
 
 from pathfuse.problem import Problem
 
-__all__ = ["replan_around_discs"]
+__all__ = ["lane_discs", "replan_around_discs"]
 
 
 def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
                         drad: np.ndarray, params: Any,
                         clearance_m: float | None = None,
-                        personal_m: float = 0.0) -> np.ndarray | None:
+                        personal_m: float = 0.0, dvel: np.ndarray | None = None,
+                        lane_s: float = 0.0) -> np.ndarray | None:
     """Waypoints ``(M, 2)`` of a new global path from ``(x, y)`` to the goal, or None.
 
     Parameters
@@ -46,6 +47,13 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
     personal_m : float
         A* only (ours, ``dwa``'s ``social_replan``): the discs are first blocked grown by
         this much more (a person's personal space); when that leaves no path, as without.
+    dvel, lane_s
+        A* only (ours, the fusion's ``replan_lane_s``): with ``lane_s > 0`` and the discs'
+        velocities ``dvel``, each disc is first blocked along the lane it sweeps at constant
+        velocity over the next ``lane_s`` seconds too (grown as with ``personal_m``, then, when
+        that leaves no path or the robot stands in it, by the robot's radius only), so the
+        path leaves a walker's lane before the walker comes; when that leaves no path either,
+        as without.
 
     Returns
     -------
@@ -67,7 +75,20 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
 
         g = problem.grid
         static = g.cspace(problem.robot_radius_m).occupied
-        if personal_m > 0.0:
+        if lane_s > 0.0 and dvel is not None:
+            lpos, lrad = lane_discs(dpos, dvel, drad, lane_s)
+            # the lanes grown with the personal space, then (the robot standing in that, or
+            # no path) by the robot's radius only
+            for grow in dict.fromkeys((float(personal_m), 0.0)):
+                occ = static.copy()
+                _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]),
+                                 float(g.resolution), lpos, lrad,
+                                 float(problem.robot_radius_m) + grow)
+                gp = plan_global(here, params.heuristic, occupied=occ)
+                if gp.success:
+                    break
+                gp = None
+        if gp is None and personal_m > 0.0:
             occ = static.copy()
             _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
                              dpos, drad, float(problem.robot_radius_m) + float(personal_m))
@@ -83,6 +104,28 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
     if not gp.success and occ is not None:  # boxed in by the discs: the static path
         gp = plan_global(here, params.heuristic)
     return np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2) if gp.success else None
+
+
+def lane_discs(dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray,
+               lane_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Each disc and copies of it along its constant-velocity motion over ``lane_s`` seconds,
+    at most half its radius apart (ours, the fusion's ``replan_lane_s``).
+
+    >>> p, r = lane_discs(np.array([[0.0, 0.0]]), np.array([[-1.0, 0.0]]), np.array([0.5]), 1.0)
+    >>> p[:, 0].tolist(), r.tolist()
+    ([0.0, -0.25, -0.5, -0.75, -1.0], [0.5, 0.5, 0.5, 0.5, 0.5])
+    """
+    ps = [dpos]
+    rs = [drad]
+    for i in range(drad.shape[0]):
+        run = float(np.hypot(dvel[i, 0], dvel[i, 1])) * lane_s
+        n = int(np.ceil(run / max(0.5 * float(drad[i]), 1e-3)))
+        if n < 1 or run < 1e-6:
+            continue
+        t = np.arange(1, n + 1)[:, None] * (lane_s / n)
+        ps.append(dpos[i] + dvel[i] * t)
+        rs.append(np.full(n, float(drad[i])))
+    return np.ascontiguousarray(np.concatenate(ps)), np.concatenate(rs)
 
 
 def _with_registered(problem: Problem, name: str, x: float, y: float, dpos: np.ndarray,

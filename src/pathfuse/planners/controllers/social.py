@@ -203,6 +203,8 @@ class SteadyDiscs:
     def __init__(self, dt: float, steady_s: float = STEADY_S) -> None:
         self.n = max(1, int(round(steady_s / float(dt))))
         self.hist: dict[int, list[tuple[float, float]]] = {}
+        self.wanders: set[int] = set()
+        """The discs sensed for :data:`STEADY_S` that are not steady (the last update)."""
 
     def update(self, ids: np.ndarray, dvel: np.ndarray) -> np.ndarray:
         """Record this tick's velocities ``dvel`` of the discs ``ids``; the steady mask."""
@@ -232,6 +234,8 @@ class SteadyDiscs:
                     break
             out[j] = ok
         self.hist = hist
+        self.wanders = {int(i) for j, i in enumerate(ids)
+                        if len(hist[int(i)]) > self.n and not out[j]}
         return out
 
 

@@ -27,6 +27,7 @@ from pathfuse.planners.controllers.dwa_checks import (
     _sweep_gap,
     path_blocks,
 )
+from pathfuse.planners.controllers.dwa_route import _local_goal, _wrap, dwa_progress, route_tangent
 from pathfuse.planners.controllers.social import EVERY_DISC, dwell_shortfall
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
 from pathfuse.sweep import arc_deviation_bound, unicycle_pose
@@ -143,60 +144,6 @@ def dwa_tick(cm, s, pts, cum, k, route, steady=EVERY_DISC):
     (:func:`keep_reference`), the route direction ``route`` and the dwell critic's mask."""
     return DwaTick(keep_reference(cm, s, pts, cum, k), float(route[0]), float(route[1]),
                    steady)
-
-
-@njit(cache=True, inline="always")
-def _wrap(a):
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
-@njit(cache=True)
-def route_tangent(pts, k, th):
-    """The unit direction of the path at its point ``k`` (the heading ``th`` where the path
-    has no length there): the route against which a disc's passing side is told."""
-    m = pts.shape[0]
-    j = min(max(k, 0), m - 1)
-    while j + 1 < m:
-        tx = pts[j + 1, 0] - pts[j, 0]
-        ty = pts[j + 1, 1] - pts[j, 1]
-        n = math.hypot(tx, ty)
-        if n > 1e-9:
-            return tx / n, ty / n
-        j += 1
-    return math.cos(th), math.sin(th)
-
-
-@njit(cache=True)
-def dwa_progress(x, y, pts, cum, k, reach_m):
-    """The nearest path point to ``(x, y)`` among those from ``k`` up to ``reach_m`` of path
-    beyond it (never behind ``k``)."""
-    m = pts.shape[0]
-    best = k
-    ex = x - pts[k, 0]
-    ey = y - pts[k, 1]
-    bd = ex * ex + ey * ey
-    j = k + 1
-    while j < m and cum[j] - cum[k] <= reach_m:
-        ex = x - pts[j, 0]
-        ey = y - pts[j, 1]
-        d = ex * ex + ey * ey
-        if d < bd:
-            bd = d
-            best = j
-        j += 1
-    return best
-
-
-@njit(cache=True)
-def _local_goal(pts, cum, k, look):
-    """Index of the path point ``look`` metres of path beyond ``pts[k]`` (the last one)."""
-    m = pts.shape[0]
-    j = k
-    while j + 1 < m and cum[j + 1] - cum[k] <= look:
-        j += 1
-    if j + 1 < m:
-        j += 1
-    return j
 
 
 @njit(cache=True)

@@ -20,7 +20,7 @@ from numba import njit
 
 from pathfuse.geometry import segment_is_clear
 
-__all__ = ["polyline_cumlen", "advance_progress", "find_rejoin"]
+__all__ = ["polyline_cumlen", "nearest_ahead", "advance_progress", "find_rejoin"]
 
 
 @njit(cache=True)
@@ -31,6 +31,32 @@ def polyline_cumlen(pts):
     for j in range(1, m):
         cum[j] = cum[j - 1] + math.hypot(pts[j, 0] - pts[j - 1, 0], pts[j, 1] - pts[j - 1, 1])
     return cum
+
+
+@njit(cache=True)
+def nearest_ahead(x, y, pts, cum, k, reach_m):
+    """The path point nearest to ``(x, y)`` among ``pts[k]`` and those after it up to
+    ``reach_m`` of path beyond it (the first of equals; never behind ``k``).
+
+    >>> pts = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    >>> int(nearest_ahead(1.9, 0.5, pts, polyline_cumlen(pts), 0, 5.0))
+    2
+    """
+    m = pts.shape[0]
+    best = k
+    ex = x - pts[k, 0]
+    ey = y - pts[k, 1]
+    bd = ex * ex + ey * ey
+    j = k + 1
+    while j < m and cum[j] - cum[k] <= reach_m:
+        ex = x - pts[j, 0]
+        ey = y - pts[j, 1]
+        d = ex * ex + ey * ey
+        if d < bd:
+            bd = d
+            best = j
+        j += 1
+    return best
 
 
 @njit(cache=True)
@@ -49,17 +75,7 @@ def advance_progress(x, y, pts, cum, k, r1_m, occ, ox, oy, res, clear):
     dk2 = ex * ex + ey * ey
     reach = math.sqrt(dk2) + r1_m
     # the nearest candidate first: usually the only one that needs a sight check
-    best = k
-    bd2 = dk2
-    j = k + 1
-    while j < m and cum[j] - cum[k] <= reach:
-        ex = x - pts[j, 0]
-        ey = y - pts[j, 1]
-        d2 = ex * ex + ey * ey
-        if d2 < bd2:
-            bd2 = d2
-            best = j
-        j += 1
+    best = nearest_ahead(x, y, pts, cum, k, reach)
     if best == k or segment_is_clear(x, y, pts[best, 0], pts[best, 1], occ, ox, oy, res, clear):
         return best
     # the nearest one is out of sight: the nearest visible one

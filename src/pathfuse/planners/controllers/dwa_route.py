@@ -18,6 +18,8 @@ import math
 
 from numba import njit
 
+from pathfuse.field.pathing import nearest_ahead
+
 __all__ = ["dwa_progress", "route_tangent"]
 
 
@@ -42,25 +44,9 @@ def route_tangent(pts, k, th):
     return math.cos(th), math.sin(th)
 
 
-@njit(cache=True)
-def dwa_progress(x, y, pts, cum, k, reach_m):
-    """The nearest path point to ``(x, y)`` among those from ``k`` up to ``reach_m`` of path
-    beyond it (never behind ``k``)."""
-    m = pts.shape[0]
-    best = k
-    ex = x - pts[k, 0]
-    ey = y - pts[k, 1]
-    bd = ex * ex + ey * ey
-    j = k + 1
-    while j < m and cum[j] - cum[k] <= reach_m:
-        ex = x - pts[j, 0]
-        ey = y - pts[j, 1]
-        d = ex * ex + ey * ey
-        if d < bd:
-            bd = d
-            best = j
-        j += 1
-    return best
+dwa_progress = nearest_ahead
+"""The nearest path point to ``(x, y)`` among those from ``k`` up to ``reach_m`` of path
+beyond it (never behind ``k``): :func:`pathfuse.field.pathing.nearest_ahead`."""
 
 
 @njit(cache=True)

@@ -20,15 +20,22 @@ Blocks and their benchmarks:
 * ``plan``: ``bench_plan.py`` (the glue around the search, per map, and a tiny query);
 * ``startup``: ``bench_startup.py`` (import, ``--help``, a first plan on a cold and a
   warm numba cache);
-* ``stepping``: ``bench_stepping.py`` (APF and fusion steps per second, fusion over A*).
+* ``stepping``: ``bench_stepping.py`` (APF and fusion steps per second, fusion over A*);
+* ``controllers``: ``bench_controllers.py`` (every online controller, both robot models);
+* ``shield``: ``bench_shield.py`` (the safety shield per command);
+* ``mppi``: ``bench_mppi.py`` (mppi against dwa per tick);
+* ``metrics``: ``bench_metrics.py`` (``evaluate()`` against its predecessor and shapely);
+* ``anyangle``: ``bench_anyangle.py`` (Theta*, Lazy Theta*, smoothed A*, ``shortest``).
+
+Each JSON records the commit of ``src/`` it measured (``-dirty`` for uncommitted changes).
 
 Usage::
 
-    python benchmarks/run_all.py [--only search peers plan startup stepping] [--no-run] [--check]
+    python benchmarks/run_all.py [--only NAME ...] [--no-run] [--check]
 
 ``--no-run`` only rewrites the speed page from the JSON already there; ``--check``
-rewrites nothing and exits 1 when a block differs from its JSON.  The run takes
-about 10 minutes on 2 cores (``--only`` to run fewer); the machine's load is
+rewrites nothing and exits 1 when a block differs from its JSON.  The whole run takes
+about half an hour on 2 cores (``--only`` to run fewer); the machine's load is
 part of every block, as the machines are shared.
 """
 

@@ -283,7 +283,9 @@ def _astar_kernel(
             break
         # ---- pop the entry with the smallest f
         if use_ring:
-            if ssize == 0:
+            if ssize > 0:
+                pi, ssize = _spop(skey, snode, ssize)
+            else:
                 pos = (cur + 1) & rmask
                 w = pos >> 6
                 word = bits[w] & (~np.uint64(0) << np.uint64(pos & 63))
@@ -293,17 +295,28 @@ def _astar_kernel(
                 b = (w << 6) + _trailing_zeros(word)
                 cur += (b - cur) & rmask
                 bits[b >> 6] &= ~(one << np.uint64(b & 63))
+                rest = word & (word - one)  # the next bucket in this word: prefetch ahead
+                if rest != 0:
+                    _fetch(cell, gbuf, np.uint64(qnode[heads[(w << 6) + _trailing_zeros(rest)]]),
+                           uw)
                 e = heads[b]
                 heads[b] = -1
-                while e >= 0:
-                    nxt = qnext[e]
-                    _fetch(cell, gbuf, np.uint64(qnode[e]), uw)
-                    ssize = _spush(skey, snode, ssize, qkey[e], np.int64(qnode[e]))
+                if qnext[e] < 0:  # one entry (the usual case): the heap would pop it
+                    pi = qnode[e]
+                    _fetch(cell, gbuf, np.uint64(pi), uw)
                     size -= 1
                     qnext[e] = fh
                     fh = e
-                    e = nxt
-            pi, ssize = _spop(skey, snode, ssize)
+                else:
+                    while e >= 0:
+                        nxt = qnext[e]
+                        _fetch(cell, gbuf, np.uint64(qnode[e]), uw)
+                        ssize = _spush(skey, snode, ssize, qkey[e], np.int64(qnode[e]))
+                        size -= 1
+                        qnext[e] = fh
+                        fh = e
+                        e = nxt
+                    pi, ssize = _spop(skey, snode, ssize)
         else:
             if heads[0] < 0:
                 i = 1

@@ -176,10 +176,14 @@ def _spop(skey, snode, size):
     return top, size
 
 
-# Long on purpose (~200 lines): the hot loop of every grid search, one function so
+# Long on purpose (~270 lines): the hot loop of every grid search, one function so
 # that numba keeps its state (the open list's heads, the current cell's word and its
 # neighbours') in locals; the pieces that stand alone are already helpers, and
-# tests/test_astar_golden.py pins its paths and expansion counts.
+# tests/test_astar_golden.py pins its paths and expansion counts.  The 8 moves are
+# written out: a loop over tuples of offsets compiled to a jump table with spilled
+# registers, a relaxation helper that takes the arrays to a call per move (each array's
+# fields on the stack) and, inlined by numba (inline="always"), to reference counting per
+# array and move; the helper versions ran 3-6x slower than the loop (issue 21).
 @njit(cache=True, nogil=True)
 def _astar_kernel(
     cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, gen,
@@ -217,7 +221,8 @@ def _astar_kernel(
       all; a bitmap (``bits``) finds the next non-empty one.  The bucket being
       expanded is moved into a binary heap (``skey``, ``snode``) ordered
       exactly by ``f``; children falling into it go straight there.  Each entry
-      moves once: best when ``f`` values are mostly distinct (euclidean).
+      moves once: best when ``f`` values are mostly distinct (euclidean).  A
+      bucket of one entry, the usual case, is popped without the heap.
 
     ``meta`` = [radix: last key / ring: current bucket, free-list head, pool
     slots used, pool entries, heap entries].  Returns (code, expansions in

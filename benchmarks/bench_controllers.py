@@ -16,6 +16,7 @@ is kept out by one warm-up episode per planner and model.
 Usage::
 
     python benchmarks/bench_controllers.py [--scenarios 10] [--planners dwa,fusion]
+                                           [--models holonomic,diff-drive]
 """
 
 from __future__ import annotations
@@ -47,7 +48,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenarios", type=int, default=10, help="generated scenarios (4 discs)")
     ap.add_argument("--planners", default="", help="comma-separated (default: all online)")
+    ap.add_argument("--models", default="holonomic,diff-drive",
+                    help="robot models, comma-separated (default: both)")
     args = ap.parse_args()
+    models = [m for m in args.models.split(",") if m]
     names = [n for n in (args.planners.split(",") if args.planners else planner_names())
              if get_planner(n).online]
     scs = scenarios(args.scenarios)
@@ -56,7 +60,7 @@ def main() -> None:
     print(f"{'planner':13s} {'robot':10s} {'decision µs (median)':>21s} {'decisions/s':>12s} "
           f"{'x real time':>12s} {'sim ticks/s':>12s} {'CPU µs/tick':>12s} {'CPU/wall':>9s}")
     rows = {}
-    for model in ("holonomic", "diff-drive"):
+    for model in models:
         for name in names:
             def run(sc, name=name, model=model):
                 rb = {"model": model, "radius": sc.robot.radius_m,
@@ -85,7 +89,7 @@ def main() -> None:
     print(f"load average {os.getloadavg()[0]:.2f} at the end")
     if "dwa" in names:
         print("\nhow many times a dwa decision costs another controller's (same robot):")
-        for model in ("holonomic", "diff-drive"):
+        for model in models:
             ref = rows[("dwa", model)]
             print(f"  {model}: " + ", ".join(f"{n} {ref / rows[(n, model)]:.0f}x"
                                             for n in names if n != "dwa"))

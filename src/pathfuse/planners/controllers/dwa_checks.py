@@ -53,6 +53,18 @@ def _near_lists(occ, ox, oy, res, field, fres, reach, dmax):
     sq = np.empty(cap, dtype=np.int64)
     dc = np.empty(cap)
     n = 0
+    # the occupied columns of each row (row rr: cols[rows[rr]:rows[rr + 1]], ascending), so
+    # that a cell's window visits its occupied squares only, in the same order as a scan
+    rows = np.zeros(h + 1, dtype=np.int64)
+    for rr in range(h):
+        rows[rr + 1] = rows[rr] + np.count_nonzero(occ[rr])
+    cols = np.empty(rows[h], dtype=np.int64)
+    for rr in range(h):
+        m = rows[rr]
+        for cc in range(w):
+            if occ[rr, cc]:
+                cols[m] = cc
+                m += 1
     for q in range(hs):
         cy = oy + (q + 0.5) * fres
         for c in range(ws):
@@ -72,23 +84,26 @@ def _near_lists(occ, ox, oy, res, field, fres, reach, dmax):
             r1 = min(int(math.floor((cy + lim - oy) / res)), h - 1)
             start[2 * i] = n
             for rr in range(r0, r1 + 1):
-                for cc in range(c0, c1 + 1):
-                    if occ[rr, cc]:
-                        x0 = ox + cc * res
-                        y0 = oy + rr * res
-                        dd = point_box_distance(cx, cy, x0, y0, x0 + res, y0 + res)
-                        if dd <= lim:
-                            if n == cap:
-                                cap *= 2
-                                grown = np.empty(cap, dtype=np.int64)
-                                grown[:n] = sq[:n]
-                                sq = grown
-                                grown_d = np.empty(cap)
-                                grown_d[:n] = dc[:n]
-                                dc = grown_d
-                            sq[n] = rr * w + cc
-                            dc[n] = dd
-                            n += 1
+                e = rows[rr + 1]
+                m = rows[rr] + np.searchsorted(cols[rows[rr]:e], c0)
+                while m < e and cols[m] <= c1:
+                    cc = cols[m]
+                    m += 1
+                    x0 = ox + cc * res
+                    y0 = oy + rr * res
+                    dd = point_box_distance(cx, cy, x0, y0, x0 + res, y0 + res)
+                    if dd <= lim:
+                        if n == cap:
+                            cap *= 2
+                            grown = np.empty(cap, dtype=np.int64)
+                            grown[:n] = sq[:n]
+                            sq = grown
+                            grown_d = np.empty(cap)
+                            grown_d[:n] = dc[:n]
+                            dc = grown_d
+                        sq[n] = rr * w + cc
+                        dc[n] = dd
+                        n += 1
             s0 = start[2 * i]
             if n - s0 > 1:  # the cell's list nearest first (_segment_distance stops early)
                 order = np.argsort(dc[s0:n], kind="mergesort")

@@ -480,8 +480,7 @@ class DWAController(Controller):
 
 _WARM = [False]
 NEAR_BUDGET = 5e6
-"""The most occupied squares (and window rows) :func:`_near_for` visits to build a map's
-near-square lists (about 30-50 ms)."""
+"""The most cells :func:`_near_for` visits to build a map's near-square lists (about 30 ms)."""
 _NEAR: weakref.WeakKeyDictionary[Any, dict[tuple[float, ...], NearSquares]] = \
     weakref.WeakKeyDictionary()
 
@@ -501,9 +500,7 @@ def _near_for(grid: Any, cm: Any, f: Any) -> NearSquares:
         return NO_NEAR
     dmax = cap + reach + 2.0 * hd + 1e-3
     side = 2.0 * (dmax + 2.0 * reach) / cm.res_m + 2.0
-    # each listed cell visits the occupied squares of its window (and its rows)
-    dense = np.count_nonzero(cm.occ) / cm.occ.size
-    if np.count_nonzero(cm.field <= dmax) * side * (1.0 + side * dense) > NEAR_BUDGET:
+    if np.count_nonzero(cm.field <= dmax) * side * side > NEAR_BUDGET:
         return NO_NEAR
     key = (cm.radius_m, cm.clear_m, cm.field_res_m, reach, dmax)
     per = _NEAR.setdefault(grid, {})

@@ -89,6 +89,19 @@ def _heuristic(r: int, c: int, gr: int, gc: int, octile: bool) -> float:
 
 
 @njit(cache=True, nogil=True)
+def _h(dy: float, dx: float, octile: bool) -> float:
+    """:func:`_heuristic` of a cell ``(dy, dx)`` from the goal, given as floats that hold
+    integers (so the squares and their sum are exact, and the value is the same)."""
+    if octile:
+        ax = abs(dx)
+        ay = abs(dy)
+        if ax > ay:
+            return ax + (1.4142135623730951 - 1.0) * ay
+        return ay + (1.4142135623730951 - 1.0) * ax
+    return math.sqrt(dx * dx + dy * dy)
+
+
+@njit(cache=True, nogil=True)
 def _qpush(qkey, qnode, qnext, heads, last, fh, used, key, node):
     """Insert (key, node) into the radix heap; returns (free-list head, used)."""
     if key < last:  # only by float rounding: f is monotone for a consistent heuristic
@@ -163,10 +176,14 @@ def _spop(skey, snode, size):
     return top, size
 
 
-# Long on purpose (~200 lines): the hot loop of every grid search, one function so
+# Long on purpose (~270 lines): the hot loop of every grid search, one function so
 # that numba keeps its state (the open list's heads, the current cell's word and its
 # neighbours') in locals; the pieces that stand alone are already helpers, and
-# tests/test_astar_golden.py pins its paths and expansion counts.
+# tests/test_astar_golden.py pins its paths and expansion counts.  The 8 moves are
+# written out: a loop over tuples of offsets compiled to a jump table with spilled
+# registers, a relaxation helper that takes the arrays to a call per move (each array's
+# fields on the stack) and, inlined by numba (inline="always"), to reference counting per
+# array and move; the helper versions ran 3-6x slower than the loop (issue 21).
 @njit(cache=True, nogil=True)
 def _astar_kernel(
     cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, gen,
@@ -204,7 +221,8 @@ def _astar_kernel(
       all; a bitmap (``bits``) finds the next non-empty one.  The bucket being
       expanded is moved into a binary heap (``skey``, ``snode``) ordered
       exactly by ``f``; children falling into it go straight there.  Each entry
-      moves once: best when ``f`` values are mostly distinct (euclidean).
+      moves once: best when ``f`` values are mostly distinct (euclidean).  A
+      bucket of one entry, the usual case, is popped without the heap.
 
     ``meta`` = [radix: last key / ring: current bucket, free-list head, pool
     slots used, pool entries, heap entries].  Returns (code, expansions in
@@ -221,10 +239,9 @@ def _astar_kernel(
     closedv = np.uint32((gen + 1) << 5)
     bit0 = np.uint32(1)
     low = np.uint32(31)
-    # the 8 moves as unsigned offsets (a negative offset wraps: p + offs[k] is exact)
-    offs = (one, ~np.uint64(0), uw, np.uint64(0) - uw, uw + one, uw - one, one - uw, ~uw)
-    drs = (0, 0, 1, -1, 1, 1, -1, -1)
-    dcs = (1, -1, 0, 0, 1, -1, 1, -1)
+    invw = 1.0 / wp
+    cq = np.empty(8, dtype=np.uint64)  # the neighbours one expansion queues, and their f
+    cf = np.empty(8)
     if start >= 0:
         us = np.uint64(start)
         gbuf[us] = 0.0
@@ -271,7 +288,9 @@ def _astar_kernel(
             break
         # ---- pop the entry with the smallest f
         if use_ring:
-            if ssize == 0:
+            if ssize > 0:
+                pi, ssize = _spop(skey, snode, ssize)
+            else:
                 pos = (cur + 1) & rmask
                 w = pos >> 6
                 word = bits[w] & (~np.uint64(0) << np.uint64(pos & 63))
@@ -281,17 +300,28 @@ def _astar_kernel(
                 b = (w << 6) + _trailing_zeros(word)
                 cur += (b - cur) & rmask
                 bits[b >> 6] &= ~(one << np.uint64(b & 63))
+                rest = word & (word - one)  # the next bucket in this word: prefetch ahead
+                if rest != 0:
+                    _fetch(cell, gbuf, np.uint64(qnode[heads[(w << 6) + _trailing_zeros(rest)]]),
+                           uw)
                 e = heads[b]
                 heads[b] = -1
-                while e >= 0:
-                    nxt = qnext[e]
-                    _fetch(cell, gbuf, np.uint64(qnode[e]), uw)
-                    ssize = _spush(skey, snode, ssize, qkey[e], np.int64(qnode[e]))
+                if qnext[e] < 0:  # one entry (the usual case): the heap would pop it
+                    pi = qnode[e]
+                    _fetch(cell, gbuf, np.uint64(pi), uw)
                     size -= 1
                     qnext[e] = fh
                     fh = e
-                    e = nxt
-            pi, ssize = _spop(skey, snode, ssize)
+                else:
+                    while e >= 0:
+                        nxt = qnext[e]
+                        _fetch(cell, gbuf, np.uint64(qnode[e]), uw)
+                        ssize = _spush(skey, snode, ssize, qkey[e], np.int64(qnode[e]))
+                        size -= 1
+                        qnext[e] = fh
+                        fh = e
+                        e = nxt
+                    pi, ssize = _spop(skey, snode, ssize)
         else:
             if heads[0] < 0:
                 i = 1
@@ -335,55 +365,77 @@ def _astar_kernel(
         if p == ugoal:
             code = CODE_SUCCESS
             break
-        # ---- relax the 8 moves
+        # ---- relax the 8 moves k = 0..7 (the word's move bits k << 1; row, col steps
+        # (0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1), as in
+        # _trace), written out: the queue order, which decides ties, is k's
         g0 = gbuf[p]
-        ur = p // uw
-        r = np.int64(ur)
-        c = np.int64(p - ur * uw)
+        ur = np.uint64(np.int64(pi) * invw)  # p // wp, off by at most one: corrected
+        if ur * uw > p:
+            ur -= one
+        elif ur * uw + uw <= p:
+            ur += one
+        dy = float(np.int64(ur) - gr)  # integers in floats: the heuristic's sums are exact
+        dx = float(np.int64(p - ur * uw) - gc)
         se = cell[p + one]
         sw = cell[p - one]
         sn = cell[p + uw]
         ss = cell[p - uw]
+        n = 0  # improved neighbours, queued below in this order
+        if se < closedv:
+            ng = g0 + 1.0
+            if se < openv or ng < gbuf[p + one]:
+                cq[n], cf[n], n = p + one, ng + _h(dy, dx + 1.0, octile), n + 1
+                gbuf[p + one], cell[p + one] = ng, openv
+        if sw < closedv:
+            ng = g0 + 1.0
+            if sw < openv or ng < gbuf[p - one]:
+                cq[n], cf[n], n = p - one, ng + _h(dy, dx - 1.0, octile), n + 1
+                gbuf[p - one], cell[p - one] = ng, openv | np.uint32(1 << 1)
+        if sn < closedv:
+            ng = g0 + 1.0
+            if sn < openv or ng < gbuf[p + uw]:
+                cq[n], cf[n], n = p + uw, ng + _h(dy + 1.0, dx, octile), n + 1
+                gbuf[p + uw], cell[p + uw] = ng, openv | np.uint32(2 << 1)
+        if ss < closedv:
+            ng = g0 + 1.0
+            if ss < openv or ng < gbuf[p - uw]:
+                cq[n], cf[n], n = p - uw, ng + _h(dy - 1.0, dx, octile), n + 1
+                gbuf[p - uw], cell[p - uw] = ng, openv | np.uint32(3 << 1)
+        # a diagonal move needs both orthogonal cells it passes free (bit 0 clear: the
+        # words read above; a relaxation never changes bit 0) unless corners may be cut
         fe = (se & bit0) == 0
         fw = (sw & bit0) == 0
         fn = (sn & bit0) == 0
         fs = (ss & bit0) == 0
-        for k in range(8):
-            q = p + offs[k]
-            if k < 4:
-                if k == 0:
-                    st = se
-                elif k == 1:
-                    st = sw
-                elif k == 2:
-                    st = sn
-                else:
-                    st = ss
-                step = 1.0
-            else:
-                if not corner_cutting:
-                    if k == 4:
-                        corner = fn and fe
-                    elif k == 5:
-                        corner = fn and fw
-                    elif k == 6:
-                        corner = fs and fe
-                    else:
-                        corner = fs and fw
-                    if not corner:
-                        continue
-                st = cell[q]
-                step = s2
-            if st >= closedv:
-                continue  # blocked, or closed
-            ng = g0 + step
-            if st >= openv and ng >= gbuf[q]:
-                continue
-            gbuf[q] = ng
-            cell[q] = openv | np.uint32(k << 1)
-            f = ng + _heuristic(r + drs[k], c + dcs[k], gr, gc, octile)
+        ng = g0 + s2
+        if corner_cutting or (fn and fe):
+            q = p + uw + one
+            st = cell[q]
+            if st < closedv and (st < openv or ng < gbuf[q]):
+                cq[n], cf[n], n = q, ng + _h(dy + 1.0, dx + 1.0, octile), n + 1
+                gbuf[q], cell[q] = ng, openv | np.uint32(4 << 1)
+        if corner_cutting or (fn and fw):
+            q = p + uw - one
+            st = cell[q]
+            if st < closedv and (st < openv or ng < gbuf[q]):
+                cq[n], cf[n], n = q, ng + _h(dy + 1.0, dx - 1.0, octile), n + 1
+                gbuf[q], cell[q] = ng, openv | np.uint32(5 << 1)
+        if corner_cutting or (fs and fe):
+            q = p - uw + one
+            st = cell[q]
+            if st < closedv and (st < openv or ng < gbuf[q]):
+                cq[n], cf[n], n = q, ng + _h(dy - 1.0, dx + 1.0, octile), n + 1
+                gbuf[q], cell[q] = ng, openv | np.uint32(6 << 1)
+        if corner_cutting or (fs and fw):
+            q = p - uw - one
+            st = cell[q]
+            if st < closedv and (st < openv or ng < gbuf[q]):
+                cq[n], cf[n], n = q, ng + _h(dy - 1.0, dx - 1.0, octile), n + 1
+                gbuf[q], cell[q] = ng, openv | np.uint32(7 << 1)
+        for j in range(n):
+            f = cf[j]
             kf = _bits_of(f)
-            qi = np.int64(q)
+            qi = np.int64(cq[j])
             if use_ring:
                 kq = np.int64(f * _RING_SCALE)
                 if kq <= cur:  # the bucket being expanded (or below it, by rounding)

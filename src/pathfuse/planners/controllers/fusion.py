@@ -157,6 +157,10 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
              "over the next replan_lane_s (grown by personal_m where social_replan), so the "
              "robot leaves a walker's lane before the walker comes rather than fleeing "
              "ahead of it; where no such path exists, as before; 0 = off")
+    lane_escape: bool = param(
+        True, help="ours (diff-drive robot online, among_discs='mppi'): MPPI's lane escape "
+                   "(mppi's lane_escape: out of a walker's lane rather than standing in it); "
+                   "false = off")
     replan_new: bool = param(
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from pathfuse.costmap import costmap_for, field_distance, segment_distance
-from pathfuse.geometry import segment_box_distance
+from pathfuse.geometry import point_box_distance, segment_box_distance
 from pathfuse.grid import GridMap
 from pathfuse.planners.controllers.dwa_checks import (
     NO_NEAR,
@@ -133,15 +133,43 @@ def test_near_squares_give_the_searched_distance() -> None:
 
 
 def test_near_squares_test_fails_when_the_lists_are_short() -> None:
-    # the test above can fail: lists that keep only each cell's first square
+    # the test above can fail: lists that keep only each cell's farthest square (the lists
+    # are nearest first), searched to their end or stopped early
     g = GridMap(np.random.default_rng(7).random((12, 15)) < 0.15, origin=(0.5, -2.0),
                 resolution=1.0)
     cm = costmap_for(g, 0.1, field_cell_m=0.05)
     near = near_squares(cm, cm.field_res_m * np.sqrt(0.5) + 0.06, 2.0)
     start = near.start.copy()
-    start[1::2] = np.minimum(start[0::2] + 1, start[1::2])
-    bad, _ = _near_mismatches(cm, NearSquares(start, near.sq, near.reach_m), 11, 1500)
-    assert bad > 20
+    start[0::2] = np.maximum(start[0::2], start[1::2] - 1)
+    for dc in (near.dc, np.zeros(0)):
+        bad, _ = _near_mismatches(cm, NearSquares(start, near.sq, near.reach_m, dc), 11, 1500)
+        assert bad > 20
+
+
+def test_near_squares_lists_are_nearest_first() -> None:
+    # the early stop of _segment_distance rests on each cell's list being sorted by its
+    # distance from the cell's centre (dc), which is that distance
+    g = GridMap(np.random.default_rng(3).random((10, 12)) < 0.2, resolution=0.5)
+    cm = costmap_for(g, 0.2, field_cell_m=0.05)
+    near = near_squares(cm, cm.field_res_m * np.sqrt(0.5) + 0.06, 1.5)
+    hs, ws = cm.field.shape
+    w = cm.occ.shape[1]
+    res = cm.res_m
+    lists = 0
+    for i in range(hs * ws):
+        s0, s1 = near.start[2 * i], near.start[2 * i + 1]
+        if s0 < 0 or s1 - s0 < 2:
+            continue
+        lists += 1
+        q, c = divmod(i, ws)
+        cx = cm.ox_m + (c + 0.5) * cm.field_res_m
+        cy = cm.oy_m + (q + 0.5) * cm.field_res_m
+        assert np.all(np.diff(near.dc[s0:s1]) >= 0.0)
+        for j in range(s0, s1):
+            rr, cc = divmod(int(near.sq[j]), w)
+            x0, y0 = cm.ox_m + cc * res, cm.oy_m + rr * res
+            assert near.dc[j] == point_box_distance(cx, cy, x0, y0, x0 + res, y0 + res)
+    assert lists > 100
 
 
 def test_sweep_gap_is_disc_sweep_gaps() -> None:

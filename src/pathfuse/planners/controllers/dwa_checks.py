@@ -32,9 +32,14 @@ class NearSquares(NamedTuple):
     start: np.ndarray
     sq: np.ndarray
     reach_m: float
+    dc: np.ndarray = np.zeros(0)
+    """Per entry of ``sq``, the distance from its lattice cell's centre to the square; each
+    cell's list sorted by it, so that :func:`_segment_distance` stops at the first square
+    that cannot be nearer than its best so far (empty: no such stop, the whole list)."""
 
 
-NO_NEAR = NearSquares(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0.0)
+NO_NEAR = NearSquares(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0.0,
+                      np.zeros(0))
 """No lists: :func:`_segment_distance` searches the squares every time."""
 
 
@@ -46,7 +51,20 @@ def _near_lists(occ, ox, oy, res, field, fres, reach, dmax):
     start = np.full(2 * hs * ws, -1, dtype=np.int64)
     cap = 1024
     sq = np.empty(cap, dtype=np.int64)
+    dc = np.empty(cap)
     n = 0
+    # the occupied columns of each row (row rr: cols[rows[rr]:rows[rr + 1]], ascending), so
+    # that a cell's window visits its occupied squares only, in the same order as a scan
+    rows = np.zeros(h + 1, dtype=np.int64)
+    for rr in range(h):
+        rows[rr + 1] = rows[rr] + np.count_nonzero(occ[rr])
+    cols = np.empty(rows[h], dtype=np.int64)
+    for rr in range(h):
+        m = rows[rr]
+        for cc in range(w):
+            if occ[rr, cc]:
+                cols[m] = cc
+                m += 1
     for q in range(hs):
         cy = oy + (q + 0.5) * fres
         for c in range(ws):
@@ -66,20 +84,33 @@ def _near_lists(occ, ox, oy, res, field, fres, reach, dmax):
             r1 = min(int(math.floor((cy + lim - oy) / res)), h - 1)
             start[2 * i] = n
             for rr in range(r0, r1 + 1):
-                for cc in range(c0, c1 + 1):
-                    if occ[rr, cc]:
-                        x0 = ox + cc * res
-                        y0 = oy + rr * res
-                        if point_box_distance(cx, cy, x0, y0, x0 + res, y0 + res) <= lim:
-                            if n == cap:
-                                cap *= 2
-                                grown = np.empty(cap, dtype=np.int64)
-                                grown[:n] = sq[:n]
-                                sq = grown
-                            sq[n] = rr * w + cc
-                            n += 1
+                e = rows[rr + 1]
+                m = rows[rr] + np.searchsorted(cols[rows[rr]:e], c0)
+                while m < e and cols[m] <= c1:
+                    cc = cols[m]
+                    m += 1
+                    x0 = ox + cc * res
+                    y0 = oy + rr * res
+                    dd = point_box_distance(cx, cy, x0, y0, x0 + res, y0 + res)
+                    if dd <= lim:
+                        if n == cap:
+                            cap *= 2
+                            grown = np.empty(cap, dtype=np.int64)
+                            grown[:n] = sq[:n]
+                            sq = grown
+                            grown_d = np.empty(cap)
+                            grown_d[:n] = dc[:n]
+                            dc = grown_d
+                        sq[n] = rr * w + cc
+                        dc[n] = dd
+                        n += 1
+            s0 = start[2 * i]
+            if n - s0 > 1:  # the cell's list nearest first (_segment_distance stops early)
+                order = np.argsort(dc[s0:n], kind="mergesort")
+                sq[s0:n] = sq[s0:n][order]
+                dc[s0:n] = dc[s0:n][order]
             start[2 * i + 1] = n
-    return start, sq[:n].copy()
+    return start, sq[:n].copy(), dc[:n].copy()
 
 
 def near_squares(cm, reach_m: float, dmax_m: float,
@@ -91,11 +122,11 @@ def near_squares(cm, reach_m: float, dmax_m: float,
     hs, ws = cm.field.shape
     if hs * ws <= 1 or hs * ws > max_entries:
         return NO_NEAR
-    start, sq = _near_lists(cm.occ, cm.ox_m, cm.oy_m, cm.res_m, cm.field, cm.field_res_m,
-                            float(reach_m), float(dmax_m))
+    start, sq, dc = _near_lists(cm.occ, cm.ox_m, cm.oy_m, cm.res_m, cm.field, cm.field_res_m,
+                                float(reach_m), float(dmax_m))
     if sq.shape[0] > max_entries:
         return NO_NEAR
-    return NearSquares(start, sq, float(reach_m))
+    return NearSquares(start, sq, float(reach_m), dc)
 
 
 @njit(cache=True, inline="always")
@@ -166,13 +197,22 @@ def _segment_distance(cm, ax, ay, bx, by, cap, slack, near):
             s0 = near.start[2 * i]
             ex = mx - (cm.ox_m + (c + 0.5) * r)
             ey = my - (cm.oy_m + (q + 0.5) * r)
-            if s0 >= 0 and math.sqrt(ex * ex + ey * ey) + half <= near.reach_m * (1.0 - 1e-9):
+            rad = math.sqrt(ex * ex + ey * ey) + half
+            if s0 >= 0 and rad <= near.reach_m * (1.0 - 1e-9):
                 best = edge_distance(cm.ox_m, cm.oy_m, cm.ox_m + w * cm.res_m,
                                      cm.oy_m + h * cm.res_m, ax, ay, bx, by, cap, slack)
                 if best == 0.0:
                     return 0.0
                 res = cm.res_m
+                # every point of the segment is within rad of the cell's centre, so a square
+                # dc from the centre is at least dc - rad from it: once that is beyond the
+                # best so far (with 1e-9 m to spare for rounding), no later square of the
+                # sorted list can be nearer (the same least distance)
+                sorted_ = near.dc.shape[0] > 0
+                tol = 1e-9 * (1.0 + abs(mx) + abs(my) + rad)
                 for j in range(s0, near.start[2 * i + 1]):
+                    if sorted_ and near.dc[j] - rad > best + tol:
+                        break
                     sq = near.sq[j]
                     rr = sq // w
                     cc = sq - rr * w
@@ -244,10 +284,11 @@ def _segment_offset(pts, j, x, y):
 
 
 @njit(cache=True, inline="always")
-def _box_distance(bb, b, x, y):
+def _box_distance2(bb, b, x, y):
+    """The squared distance from ``(x, y)`` to block ``b``'s box."""
     ox = max(bb[b, 0] - x, 0.0, x - bb[b, 2])
     oy = max(bb[b, 1] - y, 0.0, y - bb[b, 3])
-    return math.sqrt(ox * ox + oy * oy)
+    return ox * ox + oy * oy
 
 
 @njit(cache=True, inline="always")
@@ -259,7 +300,9 @@ def _path_distance(pts, cum, k, jg, bb, x, y):
     With the blocks ``bb`` (:func:`path_blocks`) it first takes the least distance
     ``bound`` over the segments of the block whose box is nearest, then scans in order,
     skipping every block whose box is farther than ``bound`` (or the best so far) by more
-    than 1e-9 m: none of its segments can be the first of least distance."""
+    than 1e-9 m: none of its segments can be the first of least distance.  (Any block's
+    least distance bounds the result from above, so ``bound`` needs no more than a block
+    near the nearest: the boxes are compared squared, without their square roots.)"""
     m = pts.shape[0]
     end = min(jg, m - 1)
     bound = np.inf
@@ -268,20 +311,23 @@ def _path_distance(pts, cum, k, jg, bb, x, y):
         bn = 0
         dn = np.inf
         for b in range(nb):
-            db = _box_distance(bb, b, x, y)
+            db = _box_distance2(bb, b, x, y)
             if db < dn:
                 dn = db
                 bn = b
+        b2 = np.inf
         for j in range(k + bn * BLOCK, min(k + (bn + 1) * BLOCK, end)):
             ex, ey, _ = _segment_offset(pts, j, x, y)
-            bound = min(bound, math.sqrt(ex * ex + ey * ey))  # within 1e-9 of the hypot
+            b2 = min(b2, ex * ex + ey * ey)
+        bound = math.sqrt(b2)  # within 1e-9 of the hypot
     pd = np.inf
     s_at = cum[m - 1]
     j = k
     while j < end:
         b = (j - k) // BLOCK
         if (j - k) % BLOCK == 0 and b < nb:
-            if _box_distance(bb, b, x, y) > min(pd, bound) + 1e-9:
+            lim = min(pd, bound) + 1e-9
+            if _box_distance2(bb, b, x, y) > lim * lim:
                 j += BLOCK
                 continue
         ex, ey, tt = _segment_offset(pts, j, x, y)

@@ -396,7 +396,8 @@ def _passive_penalty(gap):
 def dwa_choose(cm, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad, dside, chosen):
     """:func:`dwa_choose_near` without the near squares' lists (the same choice, with a
     search of the squares wherever the lattice cannot rule them out)."""
-    none = NearSquares(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0.0)
+    none = NearSquares(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0.0,
+                       np.zeros(0))
     return dwa_choose_near(cm, none, f, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel, drad,
                            dside, chosen)
 

@@ -297,10 +297,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     params = with_global_planner(parse_params(args.param), args.global_planner)
     if args.planner is None or args.planner == sc.planner.name:
         # the scenario's own planner keeps the scenario's parameters (--param overrides them)
-        choice = {"name": args.planner or sc.planner.name,
-                  "params": {**dict(sc.planner.params), **params}}
+        name, params = args.planner or sc.planner.name, {**dict(sc.planner.params), **params}
     else:
-        choice = {"name": args.planner, "params": params}
+        name = args.planner
+    choice = {"name": name, "params": params}
     robot = None
     if args.robot:
         robot = {**sc.robot.to_dict(), **_robot_block(args.robot)}
@@ -308,7 +308,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
     # the planner and its parameters are checked before the compile notice, so that a bad
     # --param is one line on stderr whether numba's cache is cold or warm
-    make_params(get_planner(str(choice["name"])), dict(choice["params"]))
+    make_params(get_planner(name), params)
     _warm_with_notice(str(choice["name"]), world=True)
     ep = simulate(sc, planner=choice, seed=args.seed, robot=robot)
     anim = None

@@ -189,6 +189,9 @@ class ForceWindow:
         self.on_path = 0
         self.lane_ticks = 0
         """Ticks the A* path led because the local path walked into a disc's lane."""
+        self.lanes_on = True
+        """False while the last replanned A* path was refused its way out of the lanes for
+        the detour (the fusion's ``replan_lane_detour_m``): the A* path does not lead then."""
         self.look_m = float(p.lookahead_m)
         self.rotate_rad = math.pi / 3.0
         """Beyond this bearing of the local path (``look_m`` along it) the robot first turns
@@ -287,7 +290,7 @@ class ForceWindow:
             net = -1.0
         lane_s = float(getattr(self.social, "replan_lane_s", 0.0)) if self.social.social \
             else 0.0
-        if lane_s > 0.0 and drad.shape[0] and net >= 0.0 \
+        if lane_s > 0.0 and self.lanes_on and drad.shape[0] and net >= 0.0 \
                 and crosses_lane(local, dpos, self.lane_velocities(obs, dvel), drad, lane_s,
                                  float(self.problem.robot_radius_m)):
             # ours (replan_lane_s): Algorithm 2's local path walks into a sensed disc's lane;

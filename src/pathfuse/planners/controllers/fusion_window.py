@@ -54,7 +54,10 @@ and while Algorithm 2's local path walks into such a lane (:func:`crosses_lane`)
 sequences track the A* path instead: Algorithm 2's goal attraction led the robot on down a
 walker's lane, MPPI's 2.5 s rollouts saw the walker too late to cross and the robot fled
 ahead of walkers faster than itself.  A disc first sensed is replanned around at once
-(``replan_new``), not up to ``replan_period_s`` later.
+(``replan_new``), not up to ``replan_period_s`` later.  The path out of the lanes is taken
+only when at most ``replan_lane_detour_m`` (2 m) longer than the path around the discs
+alone; otherwise that path, and the A* path does not lead (a disc bouncing between walls
+made the path jump by 10 m and back and the robot turn back and forth).
 
 Recovery (ours): when the robot has moved less than 0.3 m in 3 s, A* is
 planned again from where it stands and followed for 4 s, then Algorithm 2

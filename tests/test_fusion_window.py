@@ -224,11 +224,11 @@ def test_a_lane_is_not_kept_at_the_cost_of_a_long_detour():
         return float(np.hypot(*np.diff(pts, axis=0).T).sum())
 
     rep = {}
-    near = replan_around_discs(pb, 2.5, 1.5, dpos, drad, p, personal_m=0.5, dvel=dvel,
-                               lane_s=3.0, lane_detour_m=2.0, report=rep)
+    near = replan_around_discs(pb, 2.5, 1.5, dpos, drad, p, personal_m=p.personal_m,
+                               dvel=dvel, lane_s=p.replan_lane_s,
+                               lane_detour_m=p.replan_lane_detour_m, report=rep)
     assert rep["detour"] and length(near) < 9.0 and near[:, 0].max() < 4.0
     rep = {}
-    far = replan_around_discs(pb, 2.5, 1.5, dpos, drad, p, personal_m=0.5, dvel=dvel,
-                              lane_s=3.0, lane_detour_m=0.0, report=rep)
+    far = replan_around_discs(pb, 2.5, 1.5, dpos, drad, p, personal_m=p.personal_m,
+                              dvel=dvel, lane_s=p.replan_lane_s, lane_detour_m=0.0, report=rep)
     assert not rep["detour"] and length(far) > length(near) + 10.0 and far[:, 0].max() > 9.0
-    assert p.replan_lane_detour_m == 2.0

@@ -24,12 +24,16 @@ Usage::
 
     python benchmarks/bench_anyangle.py [--maps maze512-4-6 64room_005 Boston_0_1024 den312d]
         [--queries 30] [--paper-seeds 300] [--big maze512-4-6 64room_005] [--big-queries 5]
-        [--seed 0] [--data DIR] [--part 1|2]
+        [--seed 0] [--data DIR] [--part 1|2] [--json out.json]
+
+With ``--json PATH`` it also writes the figures, the machine and the load
+(``benchmarks/run_all.py`` writes the speed page's ``anyangle`` block from them).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import statistics
@@ -56,6 +60,7 @@ def timed(name, grid, start, goal):
 
 
 def part1(names, data, n_queries, seed):
+    out = []
     print("\n## Theta*, Lazy Theta* and smoothed A* against A* (MovingAI scen lines)\n")
     print("| map | planner | wall ms (median) | CPU ms | wall / A* | CPU / A* | length / A* "
           "median | min | collision-free |")
@@ -95,9 +100,15 @@ def part1(names, data, n_queries, seed):
             print(f"| {name} | {pl} | {1e3 * m:.2f} | {1e3 * mc:.2f} | {m / a:.2f} | "
                   f"{mc / ac:.2f} | {statistics.median(ratio[pl]):.4f} | {min(ratio[pl]):.4f} "
                   f"| {free[pl]}/{len(sample)} |")
+            out.append({"map": name, "planner": pl, "wall_ms": 1e3 * m, "cpu_ms": 1e3 * mc,
+                        "cpu_over_astar": mc / ac, "length_over_astar": statistics.median(
+                            ratio[pl]), "min_length_over_astar": min(ratio[pl]),
+                        "collision_free": free[pl], "queries": len(sample)})
+    return out
 
 
 def part2(big, data, n_paper, n_big, seed):
+    out: dict = {"paper_maps": n_paper, "paper": [], "big": []}
     print(f"\n## shortest on {n_paper} paper maps (through plan(), median over maps)\n")
     names = ("astar", "astar-smooth", "thetastar", "shortest")
     g0 = paper_map(0)
@@ -129,6 +140,8 @@ def part2(big, data, n_paper, n_big, seed):
         ex = float(np.mean(np.array(length[pl]) / low - 1.0))
         print(f"| {pl} | {1e3 * m:.3f} | {1e3 * mc:.3f} | {m / a:.2f} | {mc / ac:.2f} | "
               f"{100 * ex:+.2f} % |")
+        out["paper"].append({"planner": pl, "wall_ms": 1e3 * m, "cpu_ms": 1e3 * mc,
+                             "cpu_over_astar": mc / ac, "excess_over_shortest": ex})
 
     print("\n## shortest on 512-cell maps (a few scen lines each)\n")
     print("| map | corners | corner extraction ms | query | shortest s (wall) | CPU s "
@@ -157,6 +170,10 @@ def part2(big, data, n_paper, n_big, seed):
             print(f"| {name} | {len(xs)} | {1e3 * t_corners:.1f} | {q} | {w:.3f} | {c:.3f} | "
                   f"{r.expansions} | {1e3 * wa:.1f} | {1e3 * ca:.1f} | "
                   f"{r.length / ra.length:.4f} |")
+            out["big"].append({"map": name, "corners": len(xs), "query": q, "cpu_s": c,
+                               "expansions": int(r.expansions), "astar_cpu_ms": 1e3 * ca,
+                               "length_over_astar": r.length / ra.length})
+    return out
 
 
 def main(argv=None):
@@ -170,14 +187,22 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
     ap.add_argument("--part", type=int, choices=[1, 2], help="run only part 1 or part 2")
+    ap.add_argument("--json", help="write the figures to this file")
     args = ap.parse_args(argv)
+    res: dict = {"machine": {"machine": platform.machine(), "cores": os.cpu_count(),
+                             "load": round(os.getloadavg()[0], 2),
+                             "python": platform.python_version()}}
     print(f"# bench_anyangle: {platform.machine()}, {os.cpu_count()} CPUs, "
           f"load average {os.getloadavg()[0]:.2f} at the start; numpy {np.__version__}")
     if args.part != 2:
-        part1(args.maps, args.data, args.queries, args.seed)
+        res["part1"] = part1(args.maps, args.data, args.queries, args.seed)
     if args.part != 1:
-        part2(args.big, args.data, args.paper_seeds, args.big_queries, args.seed)
-    print(f"\nload average {os.getloadavg()[0]:.2f} at the end")
+        res["part2"] = part2(args.big, args.data, args.paper_seeds, args.big_queries, args.seed)
+    res["load_end"] = round(os.getloadavg()[0], 2)
+    print(f"\nload average {res['load_end']:.2f} at the end")
+    if args.json:
+        Path(args.json).write_text(json.dumps(res, indent=2))
+    return res
 
 
 if __name__ == "__main__":

@@ -51,6 +51,7 @@ import argparse
 import json
 import math
 import os
+import platform
 import statistics
 import sys
 import time
@@ -399,6 +400,7 @@ def main(argv: list[str] | None = None) -> dict:
           f"{pathfuse.__version__ if hasattr(pathfuse, '__version__') else '?'}, shapely "
           f"{shapely.__version__ if shapely else 'NOT INSTALLED (pip install shapely): skipped'}")
     print(f"cores: {ncpu} (usable {avail}); load average at start: {_load()}")
+    load0 = os.getloadavg()[0]
 
     warmup_metrics()  # numba compile / cache load, kept out of the timings
     sample_s = args.sample_ms / 1e3
@@ -465,7 +467,10 @@ def main(argv: list[str] | None = None) -> dict:
     print(f"\nchecks: new == old evaluate() and segment_clearances() on all {counts['cases']} "
           f"cases ({counts['identical']} bit for bit); shapely clearance agrees to 1e-9")
     print(f"load average at end: {_load()}")
-    out = {"cores": ncpu, "usable_cores": avail, "paper": summaries, "large": large,
+    out = {"machine": {"machine": platform.machine(), "cores": ncpu,
+                       "load": round(load0, 2), "python": platform.python_version()},
+           "load_end": round(os.getloadavg()[0], 2), "seeds": args.seeds,
+           "cores": ncpu, "usable_cores": avail, "paper": summaries, "large": large,
            "shapely_union_ms": statistics.median(t_unions) * 1e3 if t_unions else None,
            "checks": counts, "loadavg_end": os.getloadavg()}
     if args.json:

@@ -12,9 +12,12 @@ wall times), and the ratio of the medians mppi / dwa.  numba compilation is
 kept out by one warm-up episode per controller and robot.  The load average
 is printed at the start and the end.
 
+With ``--json PATH`` it also writes the figures, the machine and the load
+(``benchmarks/run_all.py`` writes the speed page's ``mppi`` block from them).
+
 Usage::
 
-    python benchmarks/bench_mppi.py [--barn DIR] [--worlds 0,17,20,43] [--params '{}']
+    python benchmarks/bench_mppi.py [--barn DIR] [--worlds 0,17,20,43] [--params '{}'] [--json F]
 """
 
 from __future__ import annotations
@@ -48,18 +51,20 @@ def episodes(barn: str, worlds: str) -> list[tuple[str, dict, dict]]:
     for f in sorted(glob.glob(str(ROOT / "examples" / "scenarios" / "*.yaml"))):
         sc = load_scenario(f)
         for model in ("diff-drive", "holonomic"):
-            rb = {"model": model, "radius": sc.robot.radius, "max_speed": sc.robot.max_speed,
-                  "sensing_radius": sc.robot.sensing_radius}
+            rb = {"model": model, "radius": sc.robot.radius_m, "max_speed": sc.robot.max_speed_mps,
+                  "sensing_radius": sc.robot.sensing_radius_m}
             out.append((f"examples {model}", f, rb))
     return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--barn", default=str(ROOT / "tests" / "data" / "barn"))
     ap.add_argument("--worlds", default=None, help="BARN worlds (default: all in --barn)")
     ap.add_argument("--params", default="{}", help="mppi parameters, as JSON")
-    args = ap.parse_args()
+    ap.add_argument("--json", help="write the figures to this file")
+    args = ap.parse_args(argv)
+    load0 = round(os.getloadavg()[0], 2)
     eps = episodes(args.barn, args.worlds)
     planners = {"mppi": {"name": "mppi", "params": json.loads(args.params)}, "dwa": "dwa"}
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores, load average "
@@ -95,7 +100,26 @@ def main() -> None:
     print(f"all episodes: mppi median {1e3 * np.median(allm):.2f} ms, dwa "
           f"{1e3 * np.median(alld):.2f} ms per tick; mppi / dwa = "
           f"{np.median(allm) / np.median(alld):.2f}")
-    print(f"load average {os.getloadavg()[0]:.2f} at the end")
+    load1 = round(os.getloadavg()[0], 2)
+    print(f"load average {load1:.2f} at the end")
+    res = {"machine": {"machine": platform.machine(), "cores": os.cpu_count(), "load": load0,
+                       "python": platform.python_version()},
+           "load_end": load1, "params": json.loads(args.params),
+           "episodes_per_controller": len(eps),
+           "rows": [{"controller": name, "episodes": label,
+                     "runs": len(outcome[(name, label)]), "ticks": int(rows[(name, label)].size),
+                     "median_ms": 1e3 * float(np.median(rows[(name, label)])),
+                     "p90_ms": 1e3 * float(np.percentile(rows[(name, label)], 90)),
+                     "cpu_ms_per_tick": 1e3 * cpu[(name, label)] / rows[(name, label)].size,
+                     "outcomes": {s: outcome[(name, label)].count(s)
+                                  for s in sorted(set(outcome[(name, label)]))}}
+                    for label in labels for name in planners],
+           "all": {name: 1e3 * float(np.median(np.concatenate(
+               [rows[(name, lb)] for lb in labels]))) for name in planners}}
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(res, f, indent=2)
+    return res
 
 
 if __name__ == "__main__":

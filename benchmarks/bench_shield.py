@@ -22,14 +22,18 @@ Medians, 95th percentiles and maxima over all states, with the process CPU
 time beside the wall time, the load average and the machine.  numba compiles
 in a warm-up first (not timed).
 
+With ``--json PATH`` it also writes the figures, the machine and the load
+(``benchmarks/run_all.py`` writes the speed page's ``shield`` block from them).
+
 Usage::
 
-    python benchmarks/bench_shield.py [--repeat 5]
+    python benchmarks/bench_shield.py [--repeat 5] [--json out.json]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import time
@@ -62,10 +66,12 @@ def states() -> tuple[list[tuple], list[float]]:
     return out, decide
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeat", type=int, default=5, help="timings per state (the least kept)")
-    a = ap.parse_args()
+    ap.add_argument("--json", help="write the figures to this file")
+    a = ap.parse_args(argv)
+    load0 = round(os.getloadavg()[0], 2)
     warmup_shield()
     data, decide = states()
     rng = np.random.default_rng(0)
@@ -116,6 +122,18 @@ def main() -> None:
               f"{np.median(x) / (ref * 1e6):18.1f}")
     print("adversarial commands: " + ", ".join(f"{n} {codes[i]}"
                                                for i, n in enumerate(CODE_NAMES)))
+    res = {"machine": {"machine": platform.machine(), "cores": os.cpu_count(), "load": load0,
+                       "python": platform.python_version()},
+           "load_end": round(os.getloadavg()[0], 2), "states": len(data), "repeat": a.repeat,
+           "rows": {name: {"median_us": float(np.median(np.asarray(v) * 1e6)),
+                           "p95_us": float(np.percentile(np.asarray(v) * 1e6, 95)),
+                           "max_us": float(np.max(np.asarray(v) * 1e6))}
+                    for name, v in rows.items()},
+           "adversarial_codes": {n: int(codes[i]) for i, n in enumerate(CODE_NAMES)}}
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(res, f, indent=2)
+    return res
 
 
 if __name__ == "__main__":

@@ -20,15 +20,22 @@ Blocks and their benchmarks:
 * ``plan``: ``bench_plan.py`` (the glue around the search, per map, and a tiny query);
 * ``startup``: ``bench_startup.py`` (import, ``--help``, a first plan on a cold and a
   warm numba cache);
-* ``stepping``: ``bench_stepping.py`` (APF and fusion steps per second, fusion over A*).
+* ``stepping``: ``bench_stepping.py`` (APF and fusion steps per second, fusion over A*);
+* ``controllers``: ``bench_controllers.py`` (every online controller, both robot models);
+* ``shield``: ``bench_shield.py`` (the safety shield per command);
+* ``mppi``: ``bench_mppi.py`` (mppi against dwa per tick);
+* ``metrics``: ``bench_metrics.py`` (``evaluate()`` against its predecessor and shapely);
+* ``anyangle``: ``bench_anyangle.py`` (Theta*, Lazy Theta*, smoothed A*, ``shortest``).
+
+Each JSON records the commit of ``src/`` it measured (``-dirty`` for uncommitted changes).
 
 Usage::
 
-    python benchmarks/run_all.py [--only search peers plan startup stepping] [--no-run] [--check]
+    python benchmarks/run_all.py [--only NAME ...] [--no-run] [--check]
 
 ``--no-run`` only rewrites the speed page from the JSON already there; ``--check``
-rewrites nothing and exits 1 when a block differs from its JSON.  The run takes
-about 10 minutes on 2 cores (``--only`` to run fewer); the machine's load is
+rewrites nothing and exits 1 when a block differs from its JSON.  The whole run takes
+about half an hour on 2 cores (``--only`` to run fewer); the machine's load is
 part of every block, as the machines are shared.
 """
 
@@ -46,7 +53,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 RESULTS = HERE / "results"
 SPEED_PAGE = ROOT / "docs" / "speed.md"  # the speed page (the README links to it)
-BLOCKS = ("search", "peers", "plan", "startup", "stepping")
+BLOCKS = ("search", "peers", "plan", "startup", "stepping", "controllers", "shield", "mppi",
+          "metrics", "anyangle")
 
 
 # ----------------------------------------------------------------------------- formatting
@@ -67,7 +75,8 @@ def ratio(x: float) -> str:
 
 def machine_line(m: dict[str, Any], load_end: float | None, command: str) -> str:
     end = f" and {load_end} at the end" if load_end is not None else ""
-    return (f"Measured with `{command}` on {m['machine']}, {m['cores']} cores, load average "
+    on = f" on commit {m['commit']}" if m.get("commit") else ""
+    return (f"Measured with `{command}`{on} on {m['machine']}, {m['cores']} cores, load average "
             f"{m['load']} at the start{end} (the machine is shared), Python {m['python']}"
             + (f", numba {m['numba']}" if "numba" in m else "") + ".")
 
@@ -243,9 +252,177 @@ def render_stepping(r: dict[str, Any]) -> str:
     ])
 
 
+def _us(x: float) -> str:
+    """A time given in microseconds, three significant digits, in ms from 1 ms up."""
+    if x >= 1000:
+        return ms(x / 1000)
+    return f"{x:.0f} µs" if x >= 100 else f"{x:.1f} µs" if x >= 10 else f"{x:.2f} µs"
+
+
+def _met(ok: bool) -> str:
+    return "met" if ok else "**not met**"
+
+
+DWA_TICKS_TARGET = 1500.0  # issue 21: simulated ticks per second, both robot models
+SHIELD_TARGET_US = 200.0  # issue 17: the shield per command
+MPPI_TARGET_MS = 20.0  # issue 17: mppi per tick on one core
+
+
+def render_controllers(r: dict[str, Any]) -> str:
+    sc = r["scenarios"]
+    rows = r["rows"]
+    names = list(dict.fromkeys(x["planner"] for x in rows))
+    get = {(x["planner"], x["robot"]): x for x in rows}
+    out = [machine_line(r["machine"], r["load_end"], "python benchmarks/bench_controllers.py"),
+           f"Every online planner drives `pathfuse.simulate` on the {sc['shipped']} shipped "
+           f"scenarios and {sc['generated']} generated ones ({sc['moving']} moving discs) with "
+           "each robot model; numba compilation is kept out by a warm-up episode per planner "
+           "and model. *Decision*: the median wall time of one control decision (the "
+           "controller through the safety shield, and on a diff-drive robot the conversion to "
+           "(v, ω)); *× real time*: decisions per second times the scenarios' `dt`; *ticks/s*: "
+           "whole simulations (world stepping and bookkeeping included) per second of wall "
+           "time and per second of the process's CPU time.", "",
+           "| controller | holonomic: decision | × real time | ticks/s wall / CPU | diff-drive: "
+           "decision | × real time | ticks/s wall / CPU |", "|---|---|---|---|---|---|---|"]
+    for n in names:
+        cells = []
+        for model in ("holonomic", "diff-drive"):
+            x = get.get((n, model))
+            if x is None:
+                cells += ["n/a"] * 3
+                continue
+            cells += [_us(x["decision_us"]), f"{x['x_real_time']:,.0f}",
+                      f"{x['ticks_per_wall_s']:,.0f} / {x['ticks_per_cpu_s']:,.0f}"]
+        out.append(f"| {n} | " + " | ".join(cells) + " |")
+    dwa = [get[("dwa", m)] for m in ("holonomic", "diff-drive") if ("dwa", m) in get]
+    if len(dwa) == 2:
+        h, d = dwa
+        ok = min(h["ticks_per_cpu_s"], d["ticks_per_cpu_s"]) >= DWA_TICKS_TARGET
+        out += ["", f"Issue 21 asks dwa for at least {DWA_TICKS_TARGET:,.0f} ticks/s on both "
+                f"robot models: {h['ticks_per_cpu_s']:,.0f} (holonomic) and "
+                f"{d['ticks_per_cpu_s']:,.0f} (diff-drive) per CPU second, "
+                f"{h['ticks_per_wall_s']:,.0f} and {d['ticks_per_wall_s']:,.0f} per wall second "
+                f"at this load: {_met(ok)}."]
+    return "\n".join(out)
+
+
+def render_shield(r: dict[str, Any]) -> str:
+    rows = r["rows"]
+    out = [machine_line(r["machine"], r["load_end"], "python benchmarks/bench_shield.py"),
+           f"The {r['states']} states of four BARN episodes (`tests/data/barn`, dwa driving the "
+           "diff-drive Jackal-sized disc of 0.333 m at 2 m/s on 0.05 m cells); each call timed "
+           f"{r['repeat']} times, the least kept; wall time. *Asked*: the shield on the command "
+           "the robot applied, as `Controller.command` calls it; *adversarial*: on full speed "
+           "at a random yaw rate, so the window search runs when that command has no safe "
+           "stop; the straight-stop check is the test the shield replaced; a dwa decision for "
+           "scale.", "", "| call | median | p95 | max |", "|---|---|---|---|"]
+    for name, x in rows.items():
+        out.append(f"| {name} | {_us(x['median_us'])} | {_us(x['p95_us'])} | "
+                   f"{_us(x['max_us'])} |")
+    worst = max(rows["shield (asked)"]["p95_us"], rows["shield (adversarial)"]["p95_us"])
+    codes = ", ".join(f"{n} {c}" for n, c in r["adversarial_codes"].items() if c)
+    out += ["", f"Outcomes of the adversarial commands: {codes}. Issue 17 asks at most "
+            f"{_us(SHIELD_TARGET_US)} per command: the 95th percentile is {_us(worst)} at most "
+            f"({_met(worst <= SHIELD_TARGET_US)})."]
+    return "\n".join(out)
+
+
+def render_mppi(r: dict[str, Any]) -> str:
+    out = [machine_line(r["machine"], r["load_end"], "python benchmarks/bench_mppi.py"),
+           f"mppi and dwa drive the same {r['episodes_per_controller']} episodes each: the four "
+           "BARN worlds of `tests/data/barn` with the diff-drive Jackal-sized disc at 1 and "
+           "2 m/s, and the example scenarios with a diff-drive and a holonomic robot; a "
+           "decision's wall time (through the shield) and the process's CPU time per simulated "
+           "tick; numba compilation kept out by a warm-up episode.", "",
+           "| controller | episodes | ticks | decision median | p90 | CPU per tick | outcomes |",
+           "|---|---|---|---|---|---|---|"]
+    for x in r["rows"]:
+        oc = ", ".join(f"{k} {v}" for k, v in x["outcomes"].items())
+        out.append(f"| {x['controller']} | {x['episodes']} | {x['ticks']} | "
+                   f"{x['median_ms']:.2f} ms | {x['p90_ms']:.2f} ms | "
+                   f"{x['cpu_ms_per_tick']:.2f} ms | {oc} |")
+    a = r["all"]
+    worst = max(x["cpu_ms_per_tick"] for x in r["rows"] if x["controller"] == "mppi")
+    out += ["", f"Over all episodes a decision takes {a['mppi']:.2f} ms for mppi and "
+            f"{a['dwa']:.2f} ms for dwa ({a['mppi'] / a['dwa']:.1f}×). Issue 17 asks mppi for at "
+            f"most {MPPI_TARGET_MS:.0f} ms per tick on one core at its defaults: at most "
+            f"{worst:.2f} ms of CPU per simulated tick over the groups above "
+            f"({_met(worst <= MPPI_TARGET_MS)})."]
+    return "\n".join(out)
+
+
+def render_metrics(r: dict[str, Any]) -> str:
+    out = [machine_line(r["machine"], r["load_end"], "python benchmarks/bench_metrics.py"),
+           f"`pathfuse.metrics.evaluate()` (length, clearance, smoothness, collision check of a "
+           f"path) on the paths of the paper's five planners on {r['seeds']} paper maps, "
+           "against the k-d tree version it replaced (`old`, kept in the benchmark) and "
+           "shapely's `LineString.distance` to the union of the obstacle squares (clearance "
+           "only; the union built beforehand); wall time per call, median over the cases.", "",
+           "| paths | cases | `evaluate()` | old `evaluate()` | old / new | `min_clearance` | "
+           "shapely |", "|---|---|---|---|---|---|---|"]
+
+    def row(s: dict[str, Any], label: str) -> str:
+        sh = f"{ms(s['shapely']['wall_ms'])}" if "shapely" in s else "n/a"
+        return (f"| {label} | {s['cases']} | {ms(s['new']['wall_ms'])} | "
+                f"{ms(s['old']['wall_ms'])} | {ratio(s['old/new'])}× | "
+                f"{ms(s['new_clr']['wall_ms'])} | {sh} |")
+
+    for s in r["paper"]:
+        out.append(row(s, "paper maps, all planners" if s["label"] == "all" else
+                       f"paper maps, {s['label']}"))
+    for s in r["large"]:
+        out.append(row(s, f"{s['map']}: {s['points']}-point path"))
+    c = r["checks"]
+    out += ["", f"The new and the old code agree on all {c['cases']} cases "
+            f"({c['identical']} bit for bit)."]
+    if r.get("shapely_union_ms") is not None:
+        out[-1] += (f" shapely's union of a paper map's squares costs {ms(r['shapely_union_ms'])}"
+                    " once per map (not in the table).")
+    return "\n".join(out)
+
+
+def render_anyangle(r: dict[str, Any]) -> str:
+    out = [machine_line(r["machine"], r["load_end"], "python benchmarks/bench_anyangle.py"),
+           "Scenario lines of MovingAI maps through `plan()`, the planners interleaved query by "
+           "query; CPU time per query, median, and its ratio to A*'s; each path's length over "
+           "A*'s, median; paths checked collision-free by `pathfuse.metrics`. numba "
+           "compilation and A*'s per-map buffers are made before the clock starts.", "",
+           "| map | planner | CPU per query | / A* | length / A* | collision-free |",
+           "|---|---|---|---|---|---|"]
+    for x in r.get("part1", []):
+        out.append(f"| {x['map']} | {x['planner']} | {ms(x['cpu_ms'])} | "
+                   f"{ratio(x['cpu_over_astar'])} | {x['length_over_astar']:.3f} | "
+                   f"{x['collision_free']}/{x['queries']} |")
+    p2 = r.get("part2")
+    if p2:
+        out += ["", f"`shortest` (the true shortest path: a visibility graph of the convex "
+                f"corners) on {p2['paper_maps']} paper maps, its corner extraction included; "
+                "CPU time per query, median, and each planner's length over the shortest, "
+                "mean:", "", "| planner | CPU per query | / A* | over the shortest |",
+                "|---|---|---|---|"]
+        for x in p2["paper"]:
+            out.append(f"| {x['planner']} | {ms(x['cpu_ms'])} | {ratio(x['cpu_over_astar'])} | "
+                       f"{100 * x['excess_over_shortest']:+.2f} % |")
+        maps = list(dict.fromkeys(x["map"] for x in p2["big"]))
+        if maps:
+            out += ["", "On 512 × 512 maps, a few of each map's 50 longest scenario lines:", "",
+                    "| map | convex corners | queries | `shortest` CPU per query | A* CPU per "
+                    "query | length / A* |", "|---|---|---|---|---|---|"]
+            for m in maps:
+                xs = [x for x in p2["big"] if x["map"] == m]
+                c = sorted(x["cpu_s"] for x in xs)
+                a = sorted(x["astar_cpu_ms"] for x in xs)
+                lr = sorted(x["length_over_astar"] for x in xs)
+                out.append(f"| {m} | {xs[0]['corners']} | {len(xs)} | "
+                           f"{c[0]:.3f}–{c[-1]:.3f} s | {ms(a[0])}–{ms(a[-1])} | "
+                           f"{lr[0]:.3f}–{lr[-1]:.3f} |")
+    return "\n".join(out)
+
+
 RENDER: dict[str, Callable[[dict[str, Any]], str]] = {
     "search": render_search, "peers": render_peers, "plan": render_plan, "startup": render_startup,
-    "stepping": render_stepping}
+    "stepping": render_stepping, "controllers": render_controllers, "shield": render_shield,
+    "mppi": render_mppi, "metrics": render_metrics, "anyangle": render_anyangle}
 
 
 def render(name: str) -> str:
@@ -278,12 +455,28 @@ def rewrite(text: str, names: list[str]) -> str:
     return text
 
 
+def commit() -> str | None:
+    """The commit measured (``-dirty`` when the work tree differs from it), if in git."""
+    import subprocess
+
+    try:
+        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, check=True,
+                             capture_output=True, text=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "src"],
+                               cwd=ROOT, check=True, capture_output=True, text=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return rev + ("-dirty" if dirty.strip() else "")
+
+
 def run(name: str) -> None:
-    """Run the benchmark of block ``name``, its JSON into benchmarks/results/."""
+    """Run the benchmark of block ``name``, its JSON into benchmarks/results/ (with the commit
+    of ``src/`` measured)."""
     sys.path.insert(0, str(HERE))
     RESULTS.mkdir(exist_ok=True)
     out = str(RESULTS / f"{name}.json")
     print(f"\n==== {name}", flush=True)
+    rev = commit()
     if name == "search":
         import bench_search
 
@@ -304,6 +497,30 @@ def run(name: str) -> None:
         import bench_stepping
 
         bench_stepping.main(["--json", out])
+    elif name == "controllers":
+        import bench_controllers
+
+        bench_controllers.main(["--json", out])
+    elif name == "shield":
+        import bench_shield
+
+        bench_shield.main(["--json", out])
+    elif name == "mppi":
+        import bench_mppi
+
+        bench_mppi.main(["--json", out])
+    elif name == "metrics":
+        import bench_metrics
+
+        bench_metrics.main(["--json", out])
+    elif name == "anyangle":
+        import bench_anyangle
+
+        bench_anyangle.main(["--json", out])
+    if rev:
+        data = json.loads(Path(out).read_text())
+        data.setdefault("machine", {})["commit"] = rev
+        Path(out).write_text(json.dumps(data, indent=2))
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -6,6 +6,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
 
 def test_help_imports_no_numpy():
     code = ("import sys, contextlib, io\n"
@@ -52,6 +54,28 @@ def test_a_static_plan_compiles_only_what_it_runs():
     assert out.stdout.split("\n")[:3] == ["[['none', 'none', 'none', 'omitted(default=None)']]",
                                         "1 0", "False"], \
         out.stdout
+
+
+@pytest.mark.parametrize("planner", ["astar", "fusion"])
+def test_a_plan_imports_only_its_planner(planner):
+    """`pathfuse plan` imports the module of the planner it runs, not the others (dwa,
+    mppi, the shield, the moving-disc worlds): their imports and numba dispatchers are part
+    of every start-up otherwise; the registry lists every built-in planner all the same."""
+    others = ("pathfuse.planners.controllers.dwa", "pathfuse.planners.controllers.mppi",
+              "pathfuse.planners.controllers.apf", "pathfuse.planners.controllers.anyangle",
+              "pathfuse.shield", "pathfuse.robot", "pathfuse.world", "matplotlib")
+    code = ("import sys, contextlib, io\n"
+            "from pathfuse.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            f"    main(['plan', '--map', 'paper', '--planner', {planner!r}])\n"
+            f"print(sorted(m for m in {others!r} if m in sys.modules))\n"
+            "from pathfuse.planners.registry import planner_names\n"
+            "print(planner_names())\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=600)
+    from pathfuse.planners.registry import _BUILTIN
+
+    assert out.stdout.split("\n")[:2] == ["[]", str(list(_BUILTIN))], out.stdout
 
 
 def test_is_cached_tells_a_field_loop_s_static_and_online_signatures(tmp_path):

@@ -448,10 +448,10 @@ def test_fusion_replans_with_personal_space_around_a_head_on_pair():
     """social_replan (ours, as dwa's): after passing the first pair low the fusion stood in
     the second pair's lane, turned to flee ahead of them and was walked into
     (corridor_head_on, seed 6); with the replanned path keeping personal_m from the people
-    it passes both pairs.  (The lanes of replan_lane_s, and replan_new, avoid it too: both
-    off here.)"""
+    it passes both pairs.  (The lanes of replan_lane_s, replan_new and MPPI's lane_escape
+    avoid it too: all off here.)"""
     world = Path(example_worlds_dir()) / "corridor_head_on.yaml"
-    before = {"seed": 6, "replan_lane_s": 0.0, "replan_new": False}
+    before = {"seed": 6, "replan_lane_s": 0.0, "replan_new": False, "lane_escape": False}
     ep = run_irsim_episode(world, "fusion", 6, before)
     assert ep.status.name == "SUCCESS" and ep.social.min_gap_m > 0.3
     off = run_irsim_episode(world, "fusion", 6, {**before, "social_replan": False})
@@ -462,11 +462,12 @@ def test_mppi_replans_with_personal_space_around_a_head_on_pair():
     """social_replan (ours, as dwa's and the fusion's): without it mppi is walked into by
     the head-on pair (corridor_head_on, seed 1); with its replanned path keeping personal_m
     from the people it reaches the goal (passing 0.04 m from them: no collision, though not
-    the personal space)."""
+    the personal space).  MPPI's lane_escape avoids it too: off here."""
     world = Path(example_worlds_dir()) / "corridor_head_on.yaml"
-    ep = run_irsim_episode(world, "mppi", 1, {"seed": 1})
+    ep = run_irsim_episode(world, "mppi", 1, {"seed": 1, "lane_escape": False})
     assert ep.status.name == "SUCCESS"
-    off = run_irsim_episode(world, "mppi", 1, {"seed": 1, "social_replan": False})
+    off = run_irsim_episode(world, "mppi", 1, {"seed": 1, "social_replan": False,
+                                               "lane_escape": False})
     assert off.status.name == "COLLISION" and off.collision_with == "person"
 
 
@@ -482,3 +483,19 @@ def test_fusion_leaves_the_lane_of_a_head_on_pair_rather_than_fleeing():
     assert ep.status.name == "SUCCESS" and ep.social.min_gap_m > 0.3
     off = run_irsim_episode(world, "fusion", 3, {"seed": 3, "replan_lane_s": 0.0})
     assert off.status.name == "COLLISION" and off.collision_with == "person"
+
+
+def test_mppi_escapes_a_head_on_pair_instead_of_standing_in_its_lane():
+    """lane_escape (ours, mppi_escape): mppi slowed in front of a pair walking head-on down a
+    4.5 m corridor (1.5 m free on either side) and stood in their lane for 2.5 s until they
+    walked into it (the training world experiments/irsim-train/west_three_lanes_wide, seed
+    1: every sample around standing met them, so the weighted mean stayed there).  With the
+    fan of escape sequences scored against the optimum it turns out of their lane in time."""
+    world = Path(__file__).resolve().parents[1] / "experiments" / "irsim-train" \
+        / "west_three_lanes_wide.yaml"
+    ep = run_irsim_episode(world, "mppi", 1, {"seed": 1}, time_limit_s=7.0)
+    assert ep.status.name != "COLLISION" and ep.social.min_gap_m > 0.0
+    off = run_irsim_episode(world, "mppi", 1, {"seed": 1, "lane_escape": False},
+                            time_limit_s=7.0)
+    assert off.status.name == "COLLISION" and off.collision_with == "person"
+    assert off.collision_at_fault is False  # walked into while standing

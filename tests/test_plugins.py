@@ -148,6 +148,23 @@ def test_cli_lists_and_plans_with_the_plugin(tmp_path):
     assert np.allclose(np.abs(np.diff(path[1:-1], axis=0)).sum(axis=1), 1.0)  # 4-connected
 
 
+def test_a_builtin_name_loads_every_builtin_before_a_plugin(tmp_path):
+    """Without a plug-in a look-up of a built-in planner imports its module alone; with one
+    installed (it may replace a built-in name) every built-in module is imported first and
+    the plug-ins after them, as on any other first use of the registry."""
+    site = _site(tmp_path, _entry_points_of_example())
+    code = ("import sys\n"
+            "from pathfuse.planners import registry\n"
+            "registry.get_planner('astar')\n"
+            "print('pathfuse.planners.controllers.dwa' in sys.modules, registry._PLUGINS_DONE)\n")
+    paths = {"without": [str(ROOT / "src")],
+             "with": [str(ROOT / "src"), str(PLUGIN / "src"), str(site)]}
+    out = {k: subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             env={**os.environ, "PYTHONPATH": os.pathsep.join(v)},
+                             check=True).stdout.strip() for k, v in paths.items()}
+    assert out == {"without": "False []", "with": "True ['', 'bfs4']"}
+
+
 def test_a_broken_plugin_is_named(tmp_path, fresh_plugins):
     site = _site(tmp_path, "[pathfuse.planners]\nbroken = no_such_module_xyz:register\n",
                  name="broken_plugin")

@@ -44,3 +44,33 @@ def test_rendering_is_deterministic_and_total():
     """Every block renders from its JSON alone, the same twice."""
     for name in run_all.BLOCKS:
         assert run_all.render(name) == run_all.render(name)
+
+
+# a speed figure: a number with a unit of time, a rate or a ratio ("12.5 ms", "3.9 M",
+# "1.84×", "550 runs/s", "40 %"); counts such as "7 × 16" or "512 × 512" are not figures
+FIGURE = re.compile(r"(?<![\w.])\d[\d,.]*(?:\s?(?:ms|µs|ns|s|min|M|MiB|GiB|%|ticks/s|runs/s|"
+                    r"steps/s)|×|x)(?![\w/])")
+
+
+def outside_blocks(text: str) -> str:
+    """The page without its generated blocks, code spans and fenced code."""
+    text = re.sub(r"<!-- speed:(\w+) begin.*?<!-- speed:\1 end -->", "", text, flags=re.S)
+    text = re.sub(r"```.*?```", "", text, flags=re.S)
+    return re.sub(r"`[^`]*`", "", text)
+
+
+def test_no_speed_figure_is_typed_outside_the_blocks():
+    """Every measured figure of the speed page comes from a benchmark's JSON (issue 21)."""
+    found = FIGURE.findall(outside_blocks(TEXT))
+    assert not found, (f"docs/speed.md has figures outside its generated blocks: {found}; "
+                       "make them part of a benchmark's block, or move dated measurements "
+                       "to docs/speed-log.md")
+
+
+def test_the_figure_rule_catches_hand_typed_figures():
+    page = ("Prose with 7 × 16 samples on 512 × 512 maps and 32-bit words.\n"
+            "<!-- speed:x begin -->\n12.5 ms\n<!-- speed:x end -->\n`--seeds 1000` `1.5 s`\n")
+    assert FIGURE.findall(outside_blocks(page)) == []
+    for typed in ("took 12.5 ms", "6.2 M expansions", "1.84× faster", "550 runs/s", "3 s",
+                  "40 %", "2x", "0.3µs"):
+        assert FIGURE.findall(outside_blocks(page + typed)), typed

@@ -301,10 +301,15 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                   "params": {**dict(sc.planner.params), **params}}
     else:
         choice = {"name": args.planner, "params": params}
-    _warm_with_notice(str(choice["name"]), world=True)
     robot = None
     if args.robot:
         robot = {**sc.robot.to_dict(), **_robot_block(args.robot)}
+    from pathfuse.planners.registry import get_planner, make_params
+
+    # the planner and its parameters are checked before the compile notice, so that a bad
+    # --param is one line on stderr whether numba's cache is cold or warm
+    make_params(get_planner(str(choice["name"])), dict(choice["params"]))
+    _warm_with_notice(str(choice["name"]), world=True)
     ep = simulate(sc, planner=choice, seed=args.seed, robot=robot)
     anim = None
     if out is not None:

@@ -318,7 +318,7 @@ def get_global_planner(name: str) -> GlobalPlannerSpec:
     spec = GLOBAL_PLANNERS.get(name) if isinstance(name, str) and _LOADED else None
     if spec is not None:
         return spec
-    _load_builtin()
+    _load_for(name, _GLOBAL_HOME)
     try:
         return GLOBAL_PLANNERS[name]
     except (KeyError, TypeError):
@@ -383,7 +383,7 @@ def get_planner(name: str) -> PlannerSpec:
     spec = REGISTRY.get(name) if isinstance(name, str) and _LOADED else None
     if spec is not None:
         return spec
-    _load_builtin()
+    _load_for(name, _HOME)
     try:
         return REGISTRY[_ALIASES.get(name, name)]
     except (KeyError, TypeError):
@@ -424,6 +424,42 @@ def make_params(spec: PlannerSpec, params: Mapping[str, Any] | None = None,
 
 
 _LOADED = False
+
+# The module (under pathfuse.planners) that registers each built-in planner, older names
+# included, and each built-in global planner: while no plug-in is installed, a look-up of
+# one of them imports that module only, so a plan of one planner does not import the
+# others (dwa, mppi, the shield...) nor create their numba dispatchers.
+_HOME = {"astar": "controllers.follow", "astar-follow": "controllers.follow",
+         "astar-replan": "controllers.follow", "apf": "controllers.apf",
+         "fusion": "controllers.fusion", "ref6": "controllers.refs", "ref7": "controllers.refs",
+         "astar-smooth": "controllers.anyangle", "thetastar": "controllers.anyangle",
+         "lazy-thetastar": "controllers.anyangle", "shortest": "controllers.anyangle",
+         "jps": "controllers.anyangle", "dwa": "controllers.dwa", "mppi": "controllers.mppi"}
+_GLOBAL_HOME = dict.fromkeys(_BUILTIN_GLOBAL, "globals.builtin")
+_NO_PLUGINS: list[bool] = []  # [whether the entry-point group is empty], looked up once
+_HOMES_DONE: set[str | None] = set()
+
+
+def _load_for(name: object, homes: Mapping[str, str]) -> None:
+    """Make ``name`` resolvable: import its built-in module alone when ``name`` is a built-in
+    one and no plug-in is installed (a plug-in may replace a built-in name, so then every
+    built-in module is imported first and the plug-ins after them,
+    :func:`_load_builtin`)."""
+    home = homes.get(name) if isinstance(name, str) else None
+    if _LOADED or home in _HOMES_DONE:
+        return
+    if home is not None and not _NO_PLUGINS:
+        from importlib.metadata import entry_points
+
+        _NO_PLUGINS.append(not entry_points(group=ENTRY_POINT_GROUP))
+    if home is None or not _NO_PLUGINS[0]:
+        _load_builtin()
+        return
+    import importlib
+
+    importlib.import_module("pathfuse.planners.globals.builtin")
+    importlib.import_module(f"pathfuse.planners.{home}")
+    _HOMES_DONE.add(home)
 
 
 def _load_builtin() -> None:

@@ -164,6 +164,10 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
              "where social_replan); otherwise that path, and Algorithm 2's local path leads "
              "(a step aside out of a walker's lane, not a long detour or a turn back round "
              "the lane of a disc that seldom walks it); 0 = no limit (as before)")
+    lane_escape: bool = param(
+        True, help="ours (diff-drive robot online, among_discs='mppi'): MPPI's lane escape "
+                   "(mppi's lane_escape: out of a walker's lane rather than standing in it); "
+                   "false = off")
     replan_new: bool = param(
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")

@@ -224,7 +224,8 @@ class ForceWindow:
 
             mp = MPPIParams(seed=self.seed, social=sp.social, social_weight=sp.social_weight,
                             personal_m=sp.personal_m, dwell_s=sp.dwell_s,
-                            dwell_weight=sp.dwell_weight)
+                            dwell_weight=sp.dwell_weight,
+                            lane_escape=bool(getattr(sp, "lane_escape", True)))
             self._mppi = MPPIController(problem, mp, _Plan(), dt=float(dt),
                                         max_speed=self.vmax)
             self._mppi.replan_every = 0  # the fusion replans (FusionController)

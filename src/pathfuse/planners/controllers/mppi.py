@@ -91,6 +91,7 @@ from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
+from pathfuse.planners.controllers.mppi_escape import ESCAPE_DWELL_S, escape_sequence
 from pathfuse.planners.controllers.mppi_kernel import mppi_optimise, pack_mppi, path_inflation
 from pathfuse.planners.controllers.replan import replan_around_discs
 from pathfuse.planners.controllers.social import EVERY_DISC, SteadyDiscs, disc_ids
@@ -175,6 +176,11 @@ class MPPIParams(PersonalSpaceParams, GlobalAStarParams):
     keep_better_guide: bool = param(True, help="take the fast guide instead of the weighted "
                                                "mean when it scores better (ours; false = the "
                                                "plain MPPI update)")
+    lane_escape: bool = param(True, help="ours: while a robot standing still would be "
+                                         "reached by a sensed disc within the horizon, score "
+                                         "a fan of sequences turning out and driving off and "
+                                         "take the best when it beats the optimum "
+                                         "(mppi_escape); false = off")
     clearance_cell_m: float = param(0.0125, gt=0, unit="m",
                                     help="cell of the clearance lookup (the map's cells are "
                                          "split down to about this, up to 8 x 8)")
@@ -267,6 +273,9 @@ class MPPIController(Controller):
             min(vmax, p.slow_guide_speed_mps), p.keep_better_guide,
             w_social=p.social_weight if p.social else 0.0, personal_m=p.personal_m,
             dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight)
+        # the lane escape's scoring carries the dwell critic even where mppi's own is off
+        self.f_escape = self.f if self.f.dwell_s >= ESCAPE_DWELL_S else self.f._replace(
+            dwell_s=ESCAPE_DWELL_S, dwell_weight=p.dwell_weight)
         self._baseline()
         n, k = int(p.time_steps), int(p.batch_size)
         self.nominal = np.zeros((n, 2))
@@ -277,6 +286,7 @@ class MPPIController(Controller):
         self.shift = max(1, int(round(self.tick_s / p.model_dt_s)))
         self.reach_m = 2.0 * vmax * self.tick_s + g.resolution + 1.0
         self.colliding_ticks = 0
+        self.escapes = 0
         self.offline_shield = np.zeros(5, dtype=np.int64)
         self._sensed = _NO_DISCS
         self.steady = SteadyDiscs(self.tick_s)
@@ -333,6 +343,12 @@ class MPPIController(Controller):
                                         self.nominal, self.noise, self.ctrl, self.weights,
                                         self.pts, self.cum, self.pexp, self.k, goal_mode, dpos,
                                         dvel, drad, dsteady)
+        if self.params.lane_escape and drad.shape[0] and escape_sequence(
+                self.costmap, self.f_escape, x, y, th, c0, c1, self.nominal, self.pts,
+                self.cum, self.pexp, self.k, goal_mode, dpos, dvel, drad, dsteady):
+            # ours (mppi_escape): out of a walker's lane rather than standing in it
+            self.escapes += 1
+            a0, a1 = self.nominal[0, 0], self.nominal[0, 1]
         if free == 0:
             self.colliding_ticks += 1
         return float(a0), float(a1)

@@ -203,3 +203,32 @@ def test_entering_among_discs_the_sequences_start_from_the_present_command(monke
     nominal, c0, c1 = seen[0]
     assert np.all(nominal[:, 0] == c0) and np.all(nominal[:, 1] == c1)
     assert c0 > 0.0  # the robot was driving when the disc came into range
+
+
+def test_a_lane_is_not_kept_at_the_cost_of_a_long_detour():
+    """replan_lane_detour_m (ours): a disc walking across the mouth of the near gap in a
+    wall blocks that gap with its 3 s lane, not with itself; out of the lane the path goes
+    round by the far gap (some 14 m longer).  With the limit (2 m, the default) the path
+    around the disc alone, through the near gap, is kept; without it (0) the detour."""
+    from pathfuse.grid import GridMap
+    from pathfuse.planners.controllers.replan import replan_around_discs
+
+    # 12 x 12 cells of 1 m (first row at the top): a wall at y = 5..6 with gaps at x = 2..3
+    # and x = 10..11
+    g = GridMap.from_rows(["." * 12] * 6 + ["##.#######.#"] + ["." * 12] * 5)
+    pb = Problem.create(g, (2.5, 1.5), (2.5, 9.5), 0.2)
+    p = make_params(get_planner("fusion"), {})
+    dpos, dvel, drad = np.array([[5.0, 4.2]]), np.array([[-1.0, 0.0]]), np.array([0.3])
+
+    def length(pts):
+        return float(np.hypot(*np.diff(pts, axis=0).T).sum())
+
+    rep = {}
+    near = replan_around_discs(pb, 2.5, 1.5, dpos, drad, p, personal_m=p.personal_m,
+                               dvel=dvel, lane_s=p.replan_lane_s,
+                               lane_detour_m=p.replan_lane_detour_m, report=rep)
+    assert rep["detour"] and length(near) < 9.0 and near[:, 0].max() < 4.0
+    rep = {}
+    far = replan_around_discs(pb, 2.5, 1.5, dpos, drad, p, personal_m=p.personal_m,
+                              dvel=dvel, lane_s=p.replan_lane_s, lane_detour_m=0.0, report=rep)
+    assert not rep["detour"] and length(far) > length(near) + 10.0 and far[:, 0].max() > 9.0

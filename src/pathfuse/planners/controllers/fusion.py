@@ -157,6 +157,13 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
              "over the next replan_lane_s (grown by personal_m where social_replan), so the "
              "robot leaves a walker's lane before the walker comes rather than fleeing "
              "ahead of it; where no such path exists, as before; 0 = off")
+    replan_lane_detour_m: float = param(
+        2.0, ge=0, le=1000, unit="m",
+        help="ours, with replan_lane_s: the path out of the lanes is taken only when it is at "
+             "most this much longer than the path around the discs alone (grown by personal_m "
+             "where social_replan); otherwise that path, and Algorithm 2's local path leads "
+             "(a step aside out of a walker's lane, not a long detour or a turn back round "
+             "the lane of a disc that seldom walks it); 0 = no limit (as before)")
     lane_escape: bool = param(
         True, help="ours (diff-drive robot online, among_discs='mppi'): MPPI's lane escape "
                    "(mppi's lane_escape: out of a walker's lane rather than standing in it); "
@@ -261,11 +268,17 @@ class FusionController(FieldController):
                 and (new_disc or self._ticks % self._replan_every == 0)
                 and int(self.state[S_MODE]) == 0):
             return
+        rep: dict[str, Any] = {}
         pts = replan_around_discs(self.problem, float(obs.position[0]),
                                   float(obs.position[1]), dpos, drad, p,
                                   personal_m=p.personal_m if p.social and p.social_replan
                                   else 0.0, dvel=self._window.lane_velocities(obs, dvel),
-                                  lane_s=p.replan_lane_s if p.social else 0.0)
+                                  lane_s=p.replan_lane_s if p.social else 0.0,
+                                  lane_detour_m=p.replan_lane_detour_m, report=rep)
+        if p.replan_lane_detour_m > 0.0:
+            # ours (replan_lane_detour_m): the A* path does not lead out of a lane when the
+            # path out of the lanes was refused for its detour
+            self._window.lanes_on = not rep["detour"]
         self.replans += 1
         if pts is None:
             return

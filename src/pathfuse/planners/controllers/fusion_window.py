@@ -54,7 +54,10 @@ and while Algorithm 2's local path walks into such a lane (:func:`crosses_lane`)
 sequences track the A* path instead: Algorithm 2's goal attraction led the robot on down a
 walker's lane, MPPI's 2.5 s rollouts saw the walker too late to cross and the robot fled
 ahead of walkers faster than itself.  A disc first sensed is replanned around at once
-(``replan_new``), not up to ``replan_period_s`` later.
+(``replan_new``), not up to ``replan_period_s`` later.  The path out of the lanes is taken
+only when at most ``replan_lane_detour_m`` (2 m) longer than the path around the discs
+alone; otherwise that path, and the A* path does not lead (a disc bouncing between walls
+made the path jump by 10 m and back and the robot turn back and forth).
 
 Recovery (ours): when the robot has moved less than 0.3 m in 3 s, A* is
 planned again from where it stands and followed for 4 s, then Algorithm 2
@@ -189,6 +192,9 @@ class ForceWindow:
         self.on_path = 0
         self.lane_ticks = 0
         """Ticks the A* path led because the local path walked into a disc's lane."""
+        self.lanes_on = True
+        """False while the last replanned A* path was refused its way out of the lanes for
+        the detour (the fusion's ``replan_lane_detour_m``): the A* path does not lead then."""
         self.look_m = float(p.lookahead_m)
         self.rotate_rad = math.pi / 3.0
         """Beyond this bearing of the local path (``look_m`` along it) the robot first turns
@@ -288,7 +294,7 @@ class ForceWindow:
             net = -1.0
         lane_s = float(getattr(self.social, "replan_lane_s", 0.0)) if self.social.social \
             else 0.0
-        if lane_s > 0.0 and drad.shape[0] and net >= 0.0 \
+        if lane_s > 0.0 and self.lanes_on and drad.shape[0] and net >= 0.0 \
                 and crosses_lane(local, dpos, self.lane_velocities(obs, dvel), drad, lane_s,
                                  float(self.problem.robot_radius_m)):
             # ours (replan_lane_s): Algorithm 2's local path walks into a sensed disc's lane;

@@ -26,7 +26,8 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
                         drad: np.ndarray, params: Any,
                         clearance_m: float | None = None,
                         personal_m: float = 0.0, dvel: np.ndarray | None = None,
-                        lane_s: float = 0.0) -> np.ndarray | None:
+                        lane_s: float = 0.0, lane_detour_m: float = 0.0,
+                        report: dict[str, Any] | None = None) -> np.ndarray | None:
     """Waypoints ``(M, 2)`` of a new global path from ``(x, y)`` to the goal, or None.
 
     Parameters
@@ -54,6 +55,15 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
         that leaves no path or the robot stands in it, by the robot's radius only), so the
         path leaves a walker's lane before the walker comes; when that leaves no path either,
         as without.
+    lane_detour_m : float
+        With the lanes (ours, the fusion's ``replan_lane_detour_m``; 0 = no limit): the path
+        out of the lanes is taken only when it is at most this much longer than the path
+        around the discs alone (grown as with ``personal_m``); otherwise that path.  A step
+        aside out of a walker's lane is worth taking, a long detour (or a turn back) round a
+        lane that a wandering or bouncing disc seldom walks is not.
+    report : dict, optional
+        Filled with ``"detour"``: whether the path out of the lanes was refused for its
+        detour (``lane_detour_m``).
 
     Returns
     -------
@@ -70,12 +80,21 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
     if clearance_m is not None and clearance_m > here.clearance_m:
         here = dataclasses.replace(here, clearance_m=clearance_m)
     gp = None
+    if report is not None:
+        report["detour"] = False
     if drad.shape[0]:
         from pathfuse.planners.controllers.follow import _rasterise_discs
 
         g = problem.grid
         static = g.cspace(problem.robot_radius_m).occupied
-        if lane_s > 0.0 and dvel is not None:
+        lanes = lane_s > 0.0 and dvel is not None \
+            and bool(np.any(np.abs(dvel) > 0.0))
+        alone = None
+        if lanes and lane_detour_m > 0.0:
+            # ours (lane_detour_m): the path around the discs alone, to compare with
+            alone = replan_around_discs(problem, x, y, dpos, drad, params, clearance_m,
+                                        personal_m)
+        if lanes and dvel is not None:
             lpos, lrad = lane_discs(dpos, dvel, drad, lane_s)
             # the lanes grown with the personal space, then (the robot standing in that, or
             # no path) by the robot's radius only
@@ -88,6 +107,12 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
                 if gp.success:
                     break
                 gp = None
+            if gp is not None and lane_detour_m > 0.0 and alone is not None:
+                wl = np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2)
+                if _length(wl) > _length(alone) + lane_detour_m:
+                    if report is not None:
+                        report["detour"] = True
+                    return alone  # the lanes would cost a long detour: around the discs
         if gp is None and personal_m > 0.0:
             occ = static.copy()
             _rasterise_discs(occ, float(g.origin[0]), float(g.origin[1]), float(g.resolution),
@@ -104,6 +129,11 @@ def replan_around_discs(problem: Problem, x: float, y: float, dpos: np.ndarray,
     if not gp.success and occ is not None:  # boxed in by the discs: the static path
         gp = plan_global(here, params.heuristic)
     return np.asarray(gp.waypoints, dtype=np.float64).reshape(-1, 2) if gp.success else None
+
+
+def _length(pts: np.ndarray) -> float:
+    """A polyline's length."""
+    return float(np.hypot(*np.diff(pts, axis=0).T).sum()) if pts.shape[0] > 1 else 0.0
 
 
 def lane_discs(dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray,

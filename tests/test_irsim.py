@@ -434,13 +434,13 @@ def test_dwa_in_irsim_does_not_drive_into_a_wall():
 def test_fusion_waits_outside_a_crossing_stream():
     """Regression: among a stream of people crossing its corridor the fusion drove into
     their lane and was walked into from behind (crossing_stream, seed 3); the dwell
-    critic keeps it out of the lane (without the replanned path's personal space, which
-    alone also avoids it now)."""
+    critic keeps it out of the lane (without the replanned path's personal space and
+    MPPI's lane_escape, each of which alone also avoids it now)."""
     world = Path(example_worlds_dir()) / "crossing_stream.yaml"
-    ep = run_irsim_episode(world, "fusion", 3, {"seed": 3, "social_replan": False})
+    before = {"seed": 3, "social_replan": False, "lane_escape": False}
+    ep = run_irsim_episode(world, "fusion", 3, before)
     assert ep.status.name == "SUCCESS" and ep.social.min_gap_m > 0.3
-    off = run_irsim_episode(world, "fusion", 3, {"seed": 3, "dwell_s": 0.0,
-                                                  "social_replan": False})
+    off = run_irsim_episode(world, "fusion", 3, {**before, "dwell_s": 0.0})
     assert off.status.name == "COLLISION" and off.collision_with == "person"
 
 
@@ -488,11 +488,10 @@ def test_fusion_leaves_the_lane_of_a_head_on_pair_rather_than_fleeing():
 def test_mppi_escapes_a_head_on_pair_instead_of_standing_in_its_lane():
     """lane_escape (ours, mppi_escape): mppi slowed in front of a pair walking head-on down a
     4.5 m corridor (1.5 m free on either side) and stood in their lane for 2.5 s until they
-    walked into it (the training world experiments/irsim-train/west_three_lanes_wide, seed
+    walked into it (the training world examples/irsim-train/west_three_lanes_wide, seed
     1: every sample around standing met them, so the weighted mean stayed there).  With the
     fan of escape sequences scored against the optimum it turns out of their lane in time."""
-    world = Path(__file__).resolve().parents[1] / "experiments" / "irsim-train" \
-        / "west_three_lanes_wide.yaml"
+    world = Path(example_worlds_dir()).parent / "irsim-train" / "west_three_lanes_wide.yaml"
     ep = run_irsim_episode(world, "mppi", 1, {"seed": 1}, time_limit_s=7.0)
     assert ep.status.name != "COLLISION" and ep.social.min_gap_m > 0.0
     off = run_irsim_episode(world, "mppi", 1, {"seed": 1, "lane_escape": False},

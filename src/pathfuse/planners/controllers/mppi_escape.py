@@ -7,7 +7,7 @@ sequences around the last optimum: a robot that has slowed in front of people co
 samples around standing, and when every such sample meets a walker within the horizon the
 weighted mean stays near standing, though standing is a sure contact.  Replayed, ``mppi``
 stood 2.5 s in front of a pair of walkers coming head-on in a 4.5 m corridor with 1.5 m free
-on either side, until they walked into it (``experiments/irsim-train/west_three_lanes_wide``,
+on either side, until they walked into it (``examples/irsim-train/west_three_lanes_wide``,
 seed 1).
 
 :func:`escape_sequence`: while the robot standing where it is would be reached by a sensed

@@ -419,6 +419,12 @@ def render_anyangle(r: dict[str, Any]) -> str:
     return "\n".join(out)
 
 
+BENCHMARK = {"search": "bench_search", "peers": "bench_astar", "plan": "bench_plan",
+             "startup": "bench_startup", "stepping": "bench_stepping",
+             "controllers": "bench_controllers", "shield": "bench_shield", "mppi": "bench_mppi",
+             "metrics": "bench_metrics", "anyangle": "bench_anyangle"}
+"""The benchmark script (in ``benchmarks/``) whose JSON makes each block."""
+
 RENDER: dict[str, Callable[[dict[str, Any]], str]] = {
     "search": render_search, "peers": render_peers, "plan": render_plan, "startup": render_startup,
     "stepping": render_stepping, "controllers": render_controllers, "shield": render_shield,
@@ -477,46 +483,9 @@ def run(name: str) -> None:
     out = str(RESULTS / f"{name}.json")
     print(f"\n==== {name}", flush=True)
     rev = commit()
-    if name == "search":
-        import bench_search
+    import importlib
 
-        bench_search.main(["--json", out])
-    elif name == "peers":
-        import bench_astar
-
-        bench_astar.main(["--json", out])
-    elif name == "plan":
-        import bench_plan
-
-        bench_plan.main(["--json", out])
-    elif name == "startup":
-        import bench_startup
-
-        bench_startup.main(["--json", out])
-    elif name == "stepping":
-        import bench_stepping
-
-        bench_stepping.main(["--json", out])
-    elif name == "controllers":
-        import bench_controllers
-
-        bench_controllers.main(["--json", out])
-    elif name == "shield":
-        import bench_shield
-
-        bench_shield.main(["--json", out])
-    elif name == "mppi":
-        import bench_mppi
-
-        bench_mppi.main(["--json", out])
-    elif name == "metrics":
-        import bench_metrics
-
-        bench_metrics.main(["--json", out])
-    elif name == "anyangle":
-        import bench_anyangle
-
-        bench_anyangle.main(["--json", out])
+    importlib.import_module(BENCHMARK[name]).main(["--json", out])
     if rev:
         data = json.loads(Path(out).read_text())
         data.setdefault("machine", {})["commit"] = rev

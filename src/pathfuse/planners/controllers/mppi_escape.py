@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from pathfuse.costmap import segment_distance
-from pathfuse.planners.controllers.mppi_kernel import _clip_holo, _clip_uni, _score, _wrap
+from pathfuse.planners.controllers.mppi_kernel import _clip_holo, _score, _turn_to, _wrap
 from pathfuse.sweep import unicycle_pose
 
 __all__ = ["ESCAPE_DWELL_S", "ESCAPE_HEADINGS", "standing_hit", "escape_sequence"]
@@ -83,14 +83,7 @@ def _towards(seq, f, x, y, th, c0, c1, heading):
         if f.holonomic:
             a, b = _clip_holo(p0, p1, vmax * math.cos(heading), vmax * math.sin(heading), h, f)
         else:
-            e = _wrap(heading - pth)
-            wd = abs(e) / h
-            if math.isfinite(alpha):
-                wd = min(wd, math.sqrt(2.0 * alpha * abs(e)))
-            wd = wd if e >= 0.0 else -wd
-            ce = math.cos(e)
-            vd = vmax * ce * ce if abs(e) < 0.5 * math.pi else 0.0
-            a, b = _clip_uni(p0, p1, vd, wd, h, f)
+            a, b = _turn_to(p0, p1, _wrap(heading - pth), vmax, h, alpha, f)
             px, py, pth = unicycle_pose(px, py, pth, a, b, h)
         seq[t, 0] = a
         seq[t, 1] = b

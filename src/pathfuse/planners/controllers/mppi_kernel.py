@@ -162,6 +162,21 @@ def _clip_holo(px, py, ux, uy, h, f):
     return ux, uy
 
 
+@njit(cache=True, inline="always")
+def _turn_to(p0, p1, e, vcap, h, alpha, f):
+    """A unicycle's command towards a heading error ``e``: the yaw rate that turns it in one
+    step as far as the heading can still stop (angular acceleration ``alpha``), the speed
+    ``vcap`` times cos^2 of the error (0 beyond 90 degrees), clipped to the window from
+    ``(p0, p1)``."""
+    wd = abs(e) / h
+    if math.isfinite(alpha):
+        wd = min(wd, math.sqrt(2.0 * alpha * abs(e)))
+    wd = wd if e >= 0.0 else -wd
+    ce = math.cos(e)
+    vd = vcap * ce * ce if abs(e) < 0.5 * math.pi else 0.0
+    return _clip_uni(p0, p1, vd, wd, h, f)
+
+
 @njit(cache=True)
 def _clip_sequence(seq, f, c0, c1):
     """Clip a sequence in place, step by step, to the limits and the acceleration windows
@@ -302,14 +317,8 @@ def _guide(seq, f, cm, x, y, th, c0, c1, pts, cum, k0, look, vslow):
             a, b = _clip_uni(p0, p1, 0.0, 0.0, h, f)
             px, py, pth = unicycle_pose(px, py, pth, a, b, h)
         else:
-            e = _wrap(math.atan2(cy - py, cx - px) - pth)
-            wd = abs(e) / h
-            if math.isfinite(alpha):
-                wd = min(wd, math.sqrt(2.0 * alpha * abs(e)))
-            wd = wd if e >= 0.0 else -wd
-            ce = math.cos(e)
-            vd = vcap * ce * ce if abs(e) < 0.5 * math.pi else 0.0
-            a, b = _clip_uni(p0, p1, vd, wd, h, f)
+            a, b = _turn_to(p0, p1, _wrap(math.atan2(cy - py, cx - px) - pth), vcap, h,
+                            alpha, f)
             px, py, pth = unicycle_pose(px, py, pth, a, b, h)
         seq[t, 0] = a
         seq[t, 1] = b

@@ -443,7 +443,8 @@ def test_warmup_idempotent():
 
 
 def test_small_heap_orders_exactly():
-    # the binary heap that orders the current ring bucket (euclidean open list)
+    # the binary heap that orders the current ring bucket (euclidean open list): _spush
+    # keeps every parent not greater than its children, ties included ...
     rng = np.random.default_rng(5)
     keys = rng.integers(0, 50, 300).astype(np.uint64)  # many ties
     skey = np.empty(300, dtype=np.uint64)
@@ -451,9 +452,19 @@ def test_small_heap_orders_exactly():
     size = 0
     for i, k in enumerate(keys):
         size = kernel_mod._spush(skey, snode, size, k, i)
-    out = []
-    while size:
-        node, size = kernel_mod._spop(skey, snode, size)
-        out.append(node)
-    assert sorted(out) == list(range(300))
-    assert np.all(np.diff(keys[out].astype(np.int64)) >= 0)
+        kids = np.arange(1, size)
+        assert np.all(skey[(kids - 1) // 2] <= skey[kids])
+    assert sorted(snode[:size].tolist()) == list(range(300))
+    assert np.all(keys[snode[:size]] == skey[:size])
+    # ... and the kernel pops it (written out in its loop) in order: on open grids, where
+    # f ties fill the buckets, every euclidean cost is the closed-form octile distance
+    for shape in ((41, 57), (64, 64)):
+        s = astar_mod.AStarSearcher(np.zeros(shape, dtype=bool))
+        for (r0, c0), (r1, c1) in rng.integers(0, min(shape), (150, 2, 2)).tolist():
+            dy, dx = abs(r1 - r0), abs(c1 - c0)
+            want = max(dy, dx) + (math.sqrt(2.0) - 1.0) * min(dy, dx)
+            res = s.search((r0, c0), (r1, c1), heuristic="euclidean")
+            assert res.cost == pytest.approx(want, rel=1e-12, abs=1e-12)
+            steps = np.abs(np.diff(res.cells, axis=0)).sum(axis=1)
+            assert (steps == 1).sum() + math.sqrt(2.0) * (steps == 2).sum() == \
+                pytest.approx(want, rel=1e-12, abs=1e-12)

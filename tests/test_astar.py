@@ -456,15 +456,23 @@ def test_small_heap_orders_exactly():
         assert np.all(skey[(kids - 1) // 2] <= skey[kids])
     assert sorted(snode[:size].tolist()) == list(range(300))
     assert np.all(keys[snode[:size]] == skey[:size])
-    # ... and the kernel pops it (written out in its loop) in order: on open grids, where
-    # f ties fill the buckets, every euclidean cost is the closed-form octile distance
-    for shape in ((41, 57), (64, 64)):
-        s = astar_mod.AStarSearcher(np.zeros(shape, dtype=bool))
-        for (r0, c0), (r1, c1) in rng.integers(0, min(shape), (150, 2, 2)).tolist():
-            dy, dx = abs(r1 - r0), abs(c1 - c0)
-            want = max(dy, dx) + (math.sqrt(2.0) - 1.0) * min(dy, dx)
-            res = s.search((r0, c0), (r1, c1), heuristic="euclidean")
-            assert res.cost == pytest.approx(want, rel=1e-12, abs=1e-12)
-            steps = np.abs(np.diff(res.cells, axis=0)).sum(axis=1)
-            assert (steps == 1).sum() + math.sqrt(2.0) * (steps == 2).sum() == \
-                pytest.approx(want, rel=1e-12, abs=1e-12)
+    # ... and the kernel pops it (written out in its loop) in order: after any number of
+    # expansions, no closed cell has an f above an open cell's (f recomputed from the
+    # stored g as the kernel computes it); open grids with a few walls fill the ring's
+    # buckets with ties, so the heap holds several entries most of the time
+    occ = np.zeros((31, 43), dtype=bool)
+    occ[8:20, 14] = occ[22, 5:30] = True
+    s = astar_mod.AStarSearcher(occ)
+    rows, cols = np.indices(occ.shape)
+    for (r0, c0), (r1, c1) in (((2, 2), (28, 40)), ((15, 40), (15, 3)), ((29, 20), (1, 21))):
+        h = np.sqrt(((rows - r1) ** 2 + (cols - c1) ** 2).astype(np.float64))
+        total = s.search((r0, c0), (r1, c1)).expansions
+        assert total > 200
+        for k in range(1, total, 7):
+            assert s.search((r0, c0), (r1, c1), max_expansions=k).expansions == k
+            word = s._cell.reshape(33, 45)[1:-1, 1:-1]
+            f = s._g.reshape(33, 45)[1:-1, 1:-1] + h
+            closed = s.closed_mask()
+            opened = (word != 0xFFFFFFFF) & ((word >> 5) == s._closed_gen - 1)
+            assert closed.sum() == k and opened.any()
+            assert f[closed].max() <= f[opened].min()

@@ -148,34 +148,6 @@ def _spush(skey, snode, size, key, node):
     return size + 1
 
 
-@njit(cache=True, nogil=True)
-def _spop(skey, snode, size):
-    """Pop the root of the small heap; returns (node, new size)."""
-    top = snode[0]
-    size -= 1
-    if size > 0:
-        key = skey[size]
-        node = snode[size]
-        i = 0
-        while True:
-            child = 2 * i + 1
-            if child >= size:
-                break
-            ck = skey[child]
-            if child + 1 < size and skey[child + 1] < ck:
-                child += 1
-                ck = skey[child]
-            if ck < key:
-                skey[i] = ck
-                snode[i] = snode[child]
-                i = child
-            else:
-                break
-        skey[i] = key
-        snode[i] = node
-    return top, size
-
-
 # Long on purpose (~270 lines): the hot loop of every grid search, one function so
 # that numba keeps its state (the open list's heads, the current cell's word and its
 # neighbours') in locals; the pieces that stand alone are already helpers, and
@@ -222,7 +194,10 @@ def _astar_kernel(
       expanded is moved into a binary heap (``skey``, ``snode``) ordered
       exactly by ``f``; children falling into it go straight there.  Each entry
       moves once: best when ``f`` values are mostly distinct (euclidean).  A
-      bucket of one entry, the usual case, is popped without the heap.
+      bucket of one entry, the usual case, is popped without the heap.  The
+      heap is a binary min-heap: a parent not greater than the key stops a
+      push (:func:`_spush`), a child not less than the moved key stops a pop
+      (written out in the loop).
 
     ``meta`` = [radix: last key / ring: current bucket, free-list head, pool
     slots used, pool entries, heap entries].  Returns (code, expansions in
@@ -288,9 +263,8 @@ def _astar_kernel(
             break
         # ---- pop the entry with the smallest f
         if use_ring:
-            if ssize > 0:
-                pi, ssize = _spop(skey, snode, ssize)
-            else:
+            pi = -1  # set below when a bucket of one entry gives the node directly
+            if ssize == 0:
                 pos = (cur + 1) & rmask
                 w = pos >> 6
                 word = bits[w] & (~np.uint64(0) << np.uint64(pos & 63))
@@ -321,7 +295,31 @@ def _astar_kernel(
                         qnext[e] = fh
                         fh = e
                         e = nxt
-                    pi, ssize = _spop(skey, snode, ssize)
+            if pi < 0:  # pop the small heap's root, written out here (as a helper it
+                # was a call that LLVM did not inline, the arrays' fields pushed on the
+                # stack for each of about one pop per expansion on the Boston maps)
+                pi = snode[0]
+                ssize -= 1
+                if ssize > 0:
+                    key = skey[ssize]
+                    node = snode[ssize]
+                    i = 0
+                    while True:
+                        child = 2 * i + 1
+                        if child >= ssize:
+                            break
+                        ck = skey[child]
+                        if child + 1 < ssize and skey[child + 1] < ck:
+                            child += 1
+                            ck = skey[child]
+                        if ck < key:
+                            skey[i] = ck
+                            snode[i] = snode[child]
+                            i = child
+                        else:
+                            break
+                    skey[i] = key
+                    snode[i] = node
         else:
             if heads[0] < 0:
                 i = 1

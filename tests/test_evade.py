@@ -106,3 +106,21 @@ def test_evader_leaves_the_lane_and_only_by_an_escape_the_shield_passes():
     plan3 = stand.copy()
     assert not ev3.choose(cm, f, 5.0, 5.0, 0.0, 0.0, 0.0, plan3, *away)
     assert np.array_equal(plan3, stand)
+
+
+def test_fusion_with_evade_passes_a_head_on_disc_through_the_shield():
+    """The switch reaches the controller: with ``evade`` on, the fusion's diff-drive robot
+    passes the shipped head-on scenario; every command went through the shield (its counts
+    add up to the ticks) and nothing was hit."""
+    from pathlib import Path
+
+    from pathfuse.world import simulate
+
+    sc = str(Path(__file__).resolve().parents[1] / "examples" / "scenarios" / "head_on.yaml")
+    robot = {"model": "diff-drive", "radius": 0.2, "max_speed": 1.0, "sensing_radius": 3.0}
+    ep = simulate(sc, planner={"name": "fusion", "params": {"evade": True}}, robot=robot)
+    assert ep.status.name == "SUCCESS", ep.message
+    assert sum(ep.shield_counts.values()) == ep.n_ticks
+    # an independent check of the gap to the disc at every tick
+    gaps = np.hypot(*(ep.positions[:, None, :] - ep.obstacle_positions).transpose(2, 0, 1))
+    assert float((gaps - ep.obstacle_radii - 0.2).min()) > 0.0

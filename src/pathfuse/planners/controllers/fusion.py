@@ -87,7 +87,7 @@ from pathfuse.field.pathing import polyline_cumlen
 from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
 from pathfuse.field.settings import pack_fusion
 from pathfuse.grid import GridMap
-from pathfuse.planners.base import FieldController, sensed_discs
+from pathfuse.planners.base import FieldController, _plain, sensed_discs
 from pathfuse.planners.controllers.replan import replan_around_discs
 from pathfuse.planners.controllers.social import disc_ids
 from pathfuse.planners.params import (
@@ -168,6 +168,14 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
         True, help="ours (diff-drive robot online, among_discs='mppi'): MPPI's lane escape "
                    "(mppi's lane_escape: out of a walker's lane rather than standing in it); "
                    "false = off")
+    evade: bool = param(
+        False, help="ours (diff-drive robot online, among_discs='mppi'): when MPPI's plan, "
+                    "rolled out and then held standing for 3 s, comes within 0.3 m of a "
+                    "sensed disc predicted at constant velocity, a fan of escape sequences "
+                    "is judged against every sensed disc's sweep (grown by 0.2 m/s) and "
+                    "the safest whose first command the shield passes unchanged (kept with "
+                    "hysteresis) replaces it (planners/controllers/evade.py); off by "
+                    "default: no gain measured (docs/results/dynamic.md)")
     replan_new: bool = param(
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")
@@ -235,11 +243,41 @@ class FusionController(FieldController):
         self.act(obs)  # Algorithm 2 keeps up with the robot, in a recovery too
         a = self._recovering(obs, self.problem.robot, force=True)
         if a is None:
+            if self._window.evader is not None:
+                self._window.passes = self._shield_passes(obs)
             a = self._window.choose(obs, self._streamline(obs), self.pts, self.cum,
                                     int(self.state[S_K]))
         if not self.problem.robot.shield:  # type: ignore[union-attr]
             return a
         return self._shielded(obs, a)
+
+    def _shield_passes(self, obs: Any) -> Any:
+        """Ours (``evade``): a test of a command against this tick's shield, True when the
+        shield would let it through unchanged (an escape the shield would hold back is not
+        taken: the robot keeps passive safety)."""
+        from pathfuse.costmap import Discs
+        from pathfuse.shield import ASKED, NV, NW, shield_unicycle
+
+        pb = self.problem
+        rb = pb.robot
+        if rb is None or not rb.shield or not len(obs.obstacles):
+            return None
+        sens = obs.obstacles
+        dp, dr = _plain(sens.positions), _plain(sens.radii)
+        discs = Discs(dp, dp, self._disc_speed_bounds(sens), dr)
+        cm = self._window.costmap
+        x, y, th = float(obs.position[0]), float(obs.position[1]), float(obs.heading)
+        c0, c1 = float(obs.command[0]), float(obs.command[1])
+        dt = float(self.dt)  # type: ignore[arg-type]
+        lim = (float(rb.min_speed_mps), float(rb.max_speed_mps), float(rb.max_accel_mps2),
+               float(rb.max_yaw_rate_radps), float(rb.max_yaw_accel_radps2))
+
+        def passes(v: float, w: float) -> bool:
+            code = shield_unicycle(cm, x, y, th, c0, c1, v, w, dt, *lim, discs, 0.0, NV,
+                                   NW)[2]
+            return bool(code == ASKED)
+
+        return passes
 
     def _set_path(self, pts: np.ndarray) -> None:
         """The global path the A* points come from, ending at the goal."""

@@ -229,6 +229,14 @@ class ForceWindow:
             self._mppi = MPPIController(problem, mp, _Plan(), dt=float(dt),
                                         max_speed=self.vmax)
             self._mppi.replan_every = 0  # the fusion replans (FusionController)
+        self.evader: Any = None
+        self.passes: Any = None
+        """The shield's test of a command this tick (set by the fusion's controller)."""
+        if among_discs == "mppi" and bool(getattr(sp, "evade", False)):
+            # ours (evade): out of a walker's swept lane instead of stopping in it
+            from pathfuse.planners.controllers.evade import Evader
+
+            self.evader = Evader(problem.goal, dt=float(dt))
 
     def relax(self, seconds: float) -> None:
         """Recovery (ours, as Nav2's clear-costmap): no obstacle critic and no margin for
@@ -373,8 +381,15 @@ class ForceWindow:
         m._sensed = (dpos, dvel, drad)
         cmd = obs.command
         self.sequenced += 1
-        a0, a1 = m._choose(float(obs.position[0]), float(obs.position[1]), float(obs.heading),
-                           float(cmd[0]), float(cmd[1]), dpos, dvel, drad, self._steady)
+        x, y, th = float(obs.position[0]), float(obs.position[1]), float(obs.heading)
+        a0, a1 = m._choose(x, y, th, float(cmd[0]), float(cmd[1]), dpos, dvel, drad,
+                           self._steady)
+        if self.evader is not None and self.evader.choose(
+                m.costmap, m.f, x, y, th, float(cmd[0]), float(cmd[1]), m.nominal, dpos, dvel,
+                drad, self.passes):
+            # ours (evade, :mod:`pathfuse.planners.controllers.evade`): the plan stops in a
+            # disc's predicted sweep; an escape out of every sensed disc's sweep instead
+            a0, a1 = float(m.nominal[0, 0]), float(m.nominal[0, 1])
         return np.array([a0, a1])
 
     def _rotate(self, err: float) -> np.ndarray:

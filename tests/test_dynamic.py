@@ -73,6 +73,22 @@ def test_records_are_the_episodes_of_pathfuse_simulate(run):
                 assert (rec["time_to_goal_s"] is None) == (ep.time_to_goal_s is None)
 
 
+def test_a_study_episode_replays_alone_with_the_run_seed():
+    # the study gives a planner with a `seed` parameter the run's seed (MPPI's sampling,
+    # and so the fusion's among discs on a diff-drive robot); simulate() with that seed,
+    # in this process after other episodes, is the study's episode tick for tick
+    cfg = DynamicConfig(n_seeds=2, moving=(2,), planners=("fusion",), seed=1,
+                        robot={"model": "diff-drive"})
+    recs = run_dynamic(cfg).records
+    scs = generate_scenarios(2, moving=2, speed_range=cfg.speed_range, seed=1,
+                             name="dyn-k2", robot={"model": "diff-drive"})
+    for i in (1, 0):
+        rec = next(r for r in recs if r["index"] == i)
+        ep = simulate(scs[i], planner={"name": "fusion", "params": {"seed": i}})
+        assert (rec["status"], rec["n_ticks"], rec["path_length_m"]) == \
+            (ep.status.name, ep.n_ticks, ep.path_length_m)
+
+
 def test_counts_add_up(run):
     rows = summary_rows(run)
     assert len(rows) == len(CFG.moving) * len(CFG.planners)

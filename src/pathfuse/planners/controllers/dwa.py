@@ -198,7 +198,7 @@ class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
                                          "sample, command the first step of the best "
                                          "turn-then-go sequence out of the discs' lanes "
                                          "that none touches; false = off")
-    lane_escape_s: float = param(3.0, gt=0, le=10, unit="s",
+    lane_escape_s: float = param(4.0, gt=0, le=10, unit="s",
                                  help="lane escape: how far ahead standing and the sequences "
                                       "are checked")
     lane_escape_steady: bool = param(True, help="lane escape: set off only by discs not "

@@ -135,3 +135,19 @@ def test_dwa_escapes_a_faster_walker_from_behind():
     assert ep.status.name == "TIMEOUT" and ep.social.min_gap_m > 0.1
     # the walker from behind (the first person) has passed the robot
     assert ep.people_positions[-1, 0, 0] > ep.positions[-1, 0] + 0.5
+
+
+def test_dwa_leaves_a_head_on_pairs_lane_rather_than_standing_at_the_wall():
+    """lane_escape: after the first pair, dwa stood by the upper wall of a 4.5 m corridor
+    (y = 5.23, as high as it can be) 0.01 m inside the lane of the second pair's upper walker
+    and was walked into after 3 s of standing (west_three_lanes_wide, seed 5).  With the
+    escape it crosses below both walkers of that pair before they arrive."""
+    world = TRAIN / "west_three_lanes_wide.yaml"
+    off = run_irsim_episode(world, "dwa", 5, {"lane_escape": False}, time_limit_s=11.0)
+    assert off.status.name == "COLLISION" and off.collision_with == "person"
+    assert off.collision_at_fault is False
+    ep = run_irsim_episode(world, "dwa", 5, time_limit_s=11.0)
+    assert ep.status.name == "TIMEOUT" and ep.social.min_gap_m > 0.3
+    # it passed the second pair (walkers 3 and 4, the upper lanes) below both
+    k = int(np.argmax(ep.people_positions[:, 2, 0] >= ep.positions[:, 0]))
+    assert k > 0 and ep.positions[k, 1] < ep.people_positions[k, 2, 1]

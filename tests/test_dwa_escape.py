@@ -21,7 +21,8 @@ EVERY = np.zeros(0, dtype=np.bool_)
 R = 0.25
 
 
-def _settings(p: DWAParams = DWAParams()):
+def _settings():
+    p = DWAParams()
     # the shipped IR-SIM robot: 1 m/s, 2 m/s^2, 2 rad/s, 4 rad/s^2, dt 0.1 s
     return pack_dwa(0.1, 0.0, 1.0, 2.0, 2.0, 4.0, 0.0, p.horizon_s, p.sim_step_s, p.v_samples,
                     p.w_samples, p.path_weight, p.goal_weight, p.heading_weight,

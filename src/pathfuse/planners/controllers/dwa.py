@@ -43,7 +43,11 @@ period:
    predicted gap).
 
 The least-cost admissible sample is commanded.  With none, the robot slows
-as hard as it can and turns towards the path ahead.  The robot's progress
+as hard as it can and turns towards the path ahead.  Among moving discs a
+diff-drive robot has a *lane escape* (ours, ``lane_escape``,
+:mod:`~pathfuse.planners.controllers.dwa_escape`): while standing would be
+walked into and so would the chosen sample, the first step of the best
+turn-then-go sequence that no disc touches is commanded instead.  The robot's progress
 along the path only moves forward, to path points in sight
 (:func:`~pathfuse.field.pathing.advance_progress`), and the global path is
 replanned from the robot's position every ``replan_period_s`` (1 s, as

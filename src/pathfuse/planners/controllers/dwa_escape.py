@@ -11,19 +11,23 @@ that a walker sweeps, and the samples that move are charged the walker's reach w
 three-lane worlds, until walked into.
 
 :func:`escape_command`: while a robot standing where it is would be touched by a sensed disc
-predicted at constant velocity within ``lane_escape_s`` (:func:`standing_contact_s`), ``dwa``'s
-chosen sample is rolled out again over that time (held, as ``dwa`` assumes, then standing where
-it ends or where the static map would stop it); if a disc touches it, a fan of *turn-then-go*
-sequences (turn towards a heading as fast as the limits allow while speeding up as
-``cos^2`` of the heading error, then drive at full speed, every step inside the acceleration
-window of the last) is rolled out the same way and the best one that no disc touches and that
-keeps clear of the static map is commanded (its first step, which is inside ``dwa``'s window).
-The sequences are scored by where they end against the global path (``dwa``'s path and goal
-critics), the least predicted gap to every disc against ``personal_m`` and the dwell critic at
-the end (:func:`~pathfuse.planners.controllers.social.dwell_shortfall`), so the side is chosen
-from every sensed disc's sweep at once; the heading escaped towards last tick is preferred
-(hysteresis).  Nothing changes while standing would be safe or ``dwa``'s own choice is not
-touched; the command still passes the safety shield.
+(one the caller trusts: ``dwa`` leaves out those seen to wander) predicted at constant
+velocity within ``lane_escape_s`` (:func:`standing_contact_s`), ``dwa``'s chosen sample is
+rolled out again over that time (held, as ``dwa`` assumes, then standing where the static map
+would stop it); if a disc touches it, a fan of *turn-then-go* sequences towards
+:data:`ESCAPE_HEADINGS` headings (turning as fast as the limits allow while speeding up as
+``cos^2`` of the heading error, or at full speed on an arc; every step inside the acceleration
+window of the last) is rolled out the same way and the best one that no disc touches is
+commanded (its first step, which is inside ``dwa``'s window).  The sequences are scored by
+where they end against the global path (``dwa``'s path and goal critics), the least predicted
+gap to every disc against ``personal_m``, the dwell critic at the end
+(:func:`~pathfuse.planners.controllers.social.dwell_shortfall`) and where they come closer to
+a disc than it can travel while the robot stops (the shield's passive safety would slow them
+there: :data:`PASSIVE_COST`), so the side is chosen from every sensed disc's sweep at once.
+While escaping (hysteresis) ``dwa``'s own choice, even untouched, must score better than the
+escape, and the heading escaped towards last tick is preferred (:data:`HOLD_BONUS`).  Nothing
+changes while standing would be safe or ``dwa``'s own choice is not touched; the command still
+passes the safety shield.
 """
 
 from __future__ import annotations

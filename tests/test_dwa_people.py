@@ -35,11 +35,13 @@ def test_dwa_overtakes_the_slow_walker():
 
 def test_dwa_waits_outside_the_lane_of_a_head_on_pair():
     """dwell_s (on in dwa now): dwa stood in front of the head-on pair, in their lane, and
-    was walked into (corridor_head_on, seed 0)."""
+    was walked into (corridor_head_on, seed 0).  The ablation is without the lane escape
+    (dwa_escape), which came later and saves this episode on its own too."""
     world = WORLDS / "corridor_head_on.yaml"
     ep = run_irsim_episode(world, "dwa", 0)
     assert _ok(ep)
-    off = run_irsim_episode(world, "dwa", 0, {"dwell_s": 0.0}, time_limit_s=10.0)
+    off = run_irsim_episode(world, "dwa", 0, {"dwell_s": 0.0, "lane_escape": False},
+                            time_limit_s=10.0)
     assert off.status.name == "COLLISION" and off.collision_with == "person"
 
 
@@ -56,11 +58,14 @@ def test_path_sides_keeps_dwa_from_standing_in_the_rvo_crowd():
 
 def test_dwa_leaves_its_clearance_along_the_wall():
     """inside_clearance: after dodging walkers dwa stood inside its own clearance by the
-    wall and found no admissible sample for the rest of the episode (sfm_flows, seed 0)."""
+    wall and found no admissible sample for the rest of the episode (sfm_flows, seed 0).  The
+    ablation is without the lane escape (dwa_escape), which came later: with it, the escape
+    moves the robot on from there too."""
     world = WORLDS / "sfm_flows.yaml"
     ep = run_irsim_episode(world, "dwa", 0, time_limit_s=45.0)
     assert ep.status.name == "SUCCESS"
-    off = run_irsim_episode(world, "dwa", 0, {"inside_clearance": False}, time_limit_s=20.0)
+    off = run_irsim_episode(world, "dwa", 0, {"inside_clearance": False, "lane_escape": False},
+                            time_limit_s=20.0)
     assert off.status.name == "TIMEOUT"
     assert np.hypot(*(off.positions[-1] - off.positions[-60])) < 0.05  # standing
 

@@ -43,7 +43,11 @@ period:
    predicted gap).
 
 The least-cost admissible sample is commanded.  With none, the robot slows
-as hard as it can and turns towards the path ahead.  The robot's progress
+as hard as it can and turns towards the path ahead.  Among moving discs a
+diff-drive robot has a *lane escape* (ours, ``lane_escape``,
+:mod:`~pathfuse.planners.controllers.dwa_escape`): while standing would be
+walked into and so would the chosen sample, the first step of the best
+turn-then-go sequence that no disc touches is commanded instead.  The robot's progress
 along the path only moves forward, to path points in sight
 (:func:`~pathfuse.field.pathing.advance_progress`), and the global path is
 replanned from the robot's position every ``replan_period_s`` (1 s, as
@@ -89,6 +93,7 @@ from pathfuse.field.pathing import advance_progress, polyline_cumlen
 from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
 from pathfuse.planners.controllers.dwa_checks import NO_NEAR, NearSquares, near_squares
+from pathfuse.planners.controllers.dwa_escape import escape_command
 from pathfuse.planners.controllers.dwa_kernel import (
     DwaTick,
     dwa_choose_near,
@@ -191,6 +196,19 @@ class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
                                             "can travel while the robot stops counts as a "
                                             "collision; false: dwa's constant-velocity "
                                             "prediction alone")
+    lane_escape: bool = param(True, help="ours (dwa_escape; diff-drive): while a robot "
+                                         "standing still would be touched by a sensed disc "
+                                         "within lane_escape_s and so would the chosen "
+                                         "sample, command the first step of the best "
+                                         "turn-then-go sequence out of the discs' lanes "
+                                         "that none touches; false = off")
+    lane_escape_s: float = param(4.0, gt=0, le=10, unit="s",
+                                 help="lane escape: how far ahead standing and the sequences "
+                                      "are checked")
+    lane_escape_steady: bool = param(True, help="lane escape: set off only by discs not "
+                                                "seen to wander (sensed for 1 s and not "
+                                                "steady, social.SteadyDiscs); false: by "
+                                                "every sensed disc")
     stall_steps: int = param(50, ge=1, help="offline: look-back of the stall test, in ticks")
     stall_distance_m: float = param(0.05, gt=0, unit="m",
                                     help="offline: a net move below this over stall_steps "
@@ -285,6 +303,8 @@ class DWAController(Controller):
         self.steady = SteadyDiscs(self.tick_s)
         self.reach_m = 2.0 * rb.max_speed_mps * self.tick_s + g.resolution + 1.0
         self.no_choice = 0
+        self.escapes = 0
+        self._escape_heading = math.nan
         self._sensed = _NO_DISCS
         self._relaxed_until = -1
         self._f_relaxed = relaxed(self.f)
@@ -342,16 +362,34 @@ class DWAController(Controller):
         chosen = np.zeros((n, 2))
         route = route_tangent(self.pts, self.k, th)
         steady = EVERY_DISC
-        if p.social and p.dwell_s > 0.0 and p.dwell_steady:
+        escape = p.lane_escape and not f.holonomic
+        if (p.social and p.dwell_s > 0.0 and p.dwell_steady) or (escape and
+                                                                  p.lane_escape_steady):
             # ours, as the fusion's (SteadyDiscs); every tick, so a disc that was out of
             # sight starts its history again
             mask = self.steady.update(ids, dvel)
-            if n:
+            if n and p.social and p.dwell_s > 0.0 and p.dwell_steady:
                 steady = mask
         tick = dwa_tick(self.costmap, f, self.pts, self.cum, self.k, route, steady)
         a0, a1, count, _ = dwa_choose_near(self.costmap, self.near, f, tick, x, y, th, c0, c1,
                                            self.pts, self.cum, self.k, dpos, dvel, drad,
                                            self.sides.sides(ids), chosen)
+        if n and escape:
+            # ours (dwa_escape): out of a walker's lane rather than standing in it; set off
+            # only by discs not seen to wander (social.SteadyDiscs, as the fusion's lanes)
+            trust = EVERY_DISC
+            if p.lane_escape_steady:
+                wanders = self.steady.wanders
+                trust = np.array([int(i) not in wanders for i in ids], dtype=np.bool_)
+            v, w, hd = escape_command(self.costmap, f, p.lane_escape_s, x, y, th, c0, c1,
+                                      float(a0), float(a1), self.pts, self.cum, self.k, dpos,
+                                      dvel, drad, tick.steady, trust, self._escape_heading)
+            self._escape_heading = hd
+            if hd == hd:
+                self.escapes += 1
+                a0, a1 = v, w
+        else:
+            self._escape_heading = math.nan
         if n:
             prefer = path_sides(self.pts, self.k, dpos, drad, self.problem.robot_radius_m,
                                 p.personal_m) if p.social and p.path_sides else None
@@ -449,7 +487,7 @@ class DWAController(Controller):
 
     @classmethod
     def kernels(cls) -> Sequence[Any]:
-        return (dwa_choose_near, advance_progress, route_tangent)
+        return (dwa_choose_near, advance_progress, route_tangent, escape_command)
 
     @classmethod
     def warmup(cls) -> None:

@@ -53,7 +53,14 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from pathfuse.costmap import Costmap, costmap_for, make_costmap, segment_clear
+from pathfuse.costmap import (
+    Costmap,
+    costmap_for,
+    make_costmap,
+    point_distance,
+    segment_clear,
+    segment_distance,
+)
 from pathfuse.grid import GridMap
 
 __all__ = [
@@ -359,6 +366,9 @@ def obstacle_trajectories(obstacles: tuple[ObstacleSpec, ...] | list[ObstacleSpe
 
 
 def warmup_obstacles() -> None:
-    """Compile (or load from numba's cache) the motion kernel."""
+    """Compile (or load from numba's cache) the motion kernel and the checks the scenario
+    and the world call from Python (a disc at a point, a straight move)."""
     cm = make_costmap(np.zeros((3, 3), dtype=np.bool_), 0.0, lattice=False)
     _bounce_trajectory(cm, 1.5, 1.5, 1.0, 0.0, 0.2, 0.5, 4, np.zeros(4))
+    point_distance(cm, 1.5, 1.5, 0.2)
+    segment_distance(cm, 1.5, 1.5, 1.6, 1.2, 0.2)

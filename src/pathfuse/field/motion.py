@@ -59,7 +59,9 @@ HOW_SLIDE = 2
 HOW_SHORT = 3
 
 
-@njit(cache=True)
+# inlined: a call per step that takes the Costmap cost the apf loop ~9 % of its steps/s
+# on a 256 x 256 map (benchmarks/bench_stepping.py; docs/speed-log.md), and compiles no slower
+@njit(cache=True, inline="always")
 def safe_step(x, y, fx, fy, step, cm, clear):
     """One collision-free move of at most ``step`` along the force ``(fx, fy)``.
 

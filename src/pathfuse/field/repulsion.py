@@ -77,7 +77,9 @@ SIDE_SPEED = 0.05
 """Sideways disc speed (m/s) above which the swerve passes behind the disc."""
 
 
-@njit(cache=True)
+# inlined: a call per step that takes the Costmap cost the apf loop ~9 % of its steps/s
+# on a 256 x 256 map (benchmarks/bench_stepping.py; docs/speed-log.md), and compiles no slower
+@njit(cache=True, inline="always")
 def grid_repulsion(x, y, cm, k_rep, rho0_m, radius_m):
     """Sum of eq. 6 over occupied cell centres closer than ``radius_m`` to ``(x, y)``.
 

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 import pathfuse
+from pathfuse.costmap import costmap_for
 from pathfuse.field.forces import att_force_xy
 from pathfuse.field.repulsion import grid_repulsion
 from pathfuse.io.gazebo import read_gazebo_world
@@ -73,8 +74,7 @@ def main() -> None:
     r = pathfuse.plan(g, BARN_START, BARN_GOAL, "ref7", robot_radius_m=RADIUS)
     sub = r.info["subgoals"][int(r.info["subgoals_reached"])]
     x, y = r.path[-1]
-    rx, ry = grid_repulsion(x, y, g.occupied, g.origin[0], g.origin[1], g.resolution,
-                            5.0, 2.0, 2.0)
+    rx, ry = grid_repulsion(x, y, costmap_for(g, 0.0, lattice=False), 5.0, 2.0, 2.0)
     ax, ay = att_force_xy(x, y, sub[0], sub[1], 40.0)
     print(f"\n{g.name} at 0.05 m: ref7 {r.status.name} at ({x:.3f}, {y:.3f}), "
           f"{np.hypot(x - sub[0], y - sub[1]):.3f} m before its sub-goal "

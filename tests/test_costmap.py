@@ -15,6 +15,7 @@ from pathfuse.costmap import (
     field_distance,
     make_costmap,
     make_discs,
+    move_clear,
     point_clear,
     point_distance,
     segment_clear,
@@ -206,3 +207,43 @@ def test_field_distance_is_a_lower_bound_and_the_edge_exact():
                 assert sq >= d - 2.0 * math.sqrt(2.0) * cm.field_res_m - 1e-12
             assert edge == pytest.approx(min(x - cm.ox_m, cm.xmax_m - x, y - cm.oy_m,
                                              cm.ymax_m - y), abs=1e-12)
+
+
+def test_move_clear_is_the_planners_move_rule_against_an_exact_oracle():
+    # clear of every square by `clear`, and inside the map by the radius (clear less the
+    # margin) only: a robot may touch the map's edge, where segment_clear keeps the margin
+    shapely = pytest.importorskip("shapely")
+    from shapely.geometry import LineString, Point, box
+
+    rng = np.random.default_rng(7)
+    for _ in range(30):
+        cm = _random_costmap(rng, radius=float(rng.uniform(0.0, 0.6)))
+        x0, y0, x1, y1 = _squares(cm)
+        boxes = shapely.union_all([box(*b) for b in zip(x0, y0, x1, y1, strict=True)])
+        clear = cm.clear_m
+        edge = clear - MARGIN_FRAC * cm.res_m
+        xs, ys = _inside(rng, cm, 60)
+        for i in range(60):
+            a = (float(xs[i]), float(ys[i]))
+            b = (float(xs[i - 1]), float(ys[i - 1])) if i % 3 else a
+            geom = LineString([a, b]) if a != b else Point(a)
+            d = geom.distance(boxes) if not boxes.is_empty else math.inf
+            inside = all(cm.ox_m + edge <= p[0] <= cm.xmax_m - edge
+                         and cm.oy_m + edge <= p[1] <= cm.ymax_m - edge for p in (a, b))
+            if abs(d - clear) > 1e-9:
+                assert move_clear(cm, *a, *b, clear) == (inside and d > clear)
+    # on a free map a robot may stand its radius from the edge (not its clearance)
+    cm = make_costmap(np.zeros((4, 4), dtype=np.bool_), 0.3, origin=(1.0, 2.0))
+    x = cm.ox_m + (cm.clear_m - MARGIN_FRAC * cm.res_m)
+    assert move_clear(cm, x, 3.0, x, 4.0, cm.clear_m)
+    assert not segment_clear(cm, x, 3.0, x, 4.0, cm.clear_m)
+    assert not move_clear(cm, x - 1e-9, 3.0, x, 4.0, cm.clear_m)
+
+
+def test_the_world_kernels_the_bench_warms_exist():
+    # bench.warmup names the world's numba kernels to tell a cold cache; a kernel that is
+    # gone (the discs' old _clear) made cold_kernels_of(world=True) raise AttributeError
+    from pathfuse.bench import warmup
+
+    assert all(hasattr(k, "_cache") for k in warmup._world_kernels())
+    assert isinstance(warmup.cold_kernels_of([], metrics=False, world=True), list)

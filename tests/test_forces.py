@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from pathfuse.costmap import costmap_for, make_costmap
 from pathfuse.field import forces
 from pathfuse.field.forces import (
     att_force_xy,
@@ -139,8 +140,8 @@ def test_grid_repulsion_equals_sum_over_every_obstacle(seed, res):
     goal = np.array([x1 - 0.3, y1 - 0.4])
     for p in np.column_stack([rng.uniform(x0, x1, 40), rng.uniform(y0, y1, 40)]):
         brute = total_force(p, goal, centres, 40.0, 5.0, 2.0)
-        fast = apf_force(p[0], p[1], goal[0], goal[1], 40.0, 5.0, 2.0, 2.0, g.occupied,
-                         g.origin[0], g.origin[1], g.resolution)
+        fast = apf_force(p[0], p[1], goal[0], goal[1], 40.0, 5.0, 2.0, 2.0,
+                         costmap_for(g, 0.0, lattice=False))
         np.testing.assert_allclose(fast, brute, rtol=1e-10, atol=1e-9)
 
 
@@ -148,8 +149,9 @@ def test_grid_repulsion_radius_truncates():
     # obstacle at distance 1.5: inside rho0 = 2 but outside a sensing radius r2 = 1
     occ = np.zeros((5, 5), dtype=bool)
     occ[2, 4] = True  # centre (4.5, 2.5)
-    full = grid_repulsion(3.0, 2.5, occ, 0.0, 0.0, 1.0, 5.0, 2.0, 2.0)
-    cut = grid_repulsion(3.0, 2.5, occ, 0.0, 0.0, 1.0, 5.0, 2.0, 1.0)
+    cm = make_costmap(occ, 0.0, lattice=False)
+    full = grid_repulsion(3.0, 2.5, cm, 5.0, 2.0, 2.0)
+    cut = grid_repulsion(3.0, 2.5, cm, 5.0, 2.0, 1.0)
     assert full[0] == pytest.approx(-5 * (1 / 1.5 - 0.5) / 1.5**2)
     assert cut == (0.0, 0.0)
 
@@ -159,11 +161,11 @@ def test_grid_repulsion_radius_truncates():
 def test_resultant_force_finite_at_any_point(seed, x, y):
     g = _random_grid(seed, shape=(15, 15), density=0.3)
     # include obstacle centres exactly and points off the map
-    f = apf_force(x, y, 11.0, 11.0, 40.0, 5.0, 2.0, 2.0, g.occupied, -0.5, -0.5, 1.0)
+    cm = make_costmap(g.occupied, 0.0, origin=(-0.5, -0.5), lattice=False)
+    f = apf_force(x, y, 11.0, 11.0, 40.0, 5.0, 2.0, 2.0, cm)
     assert np.all(np.isfinite(f))
     c = g.cell_to_world(np.argwhere(g.occupied))[0]
-    assert np.all(np.isfinite(apf_force(c[0], c[1], 11.0, 11.0, 40.0, 5.0, 2.0, 2.0,
-                                        g.occupied, -0.5, -0.5, 1.0)))
+    assert np.all(np.isfinite(apf_force(c[0], c[1], 11.0, 11.0, 40.0, 5.0, 2.0, 2.0, cm)))
 
 
 # ------------------------------------------------------------------ exact collision test
@@ -230,8 +232,8 @@ def test_safe_step_never_collides(seed, angle, step, radius):
             break
     else:
         return
-    nx, ny, how = safe_step(x, y, math.cos(angle), math.sin(angle), step, g.occupied, 0.0, 0.0,
-                            1.0, clear)
+    cm = make_costmap(g.occupied, 0.0, lattice=False)
+    nx, ny, how = safe_step(x, y, math.cos(angle), math.sin(angle), step, cm, clear)
     assert math.hypot(nx - x, ny - y) <= step * (1 + 1e-12)
     if how == HOW_BLOCKED:
         assert (nx, ny) == (x, y)

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pathfuse import Budget, ConfigError, GridMap, Status, plan
+from pathfuse.costmap import costmap_for
 from pathfuse.field.forces import repulsive_force
 from pathfuse.field.repulsion import grid_improved_repulsion
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
@@ -187,14 +188,14 @@ def test_grid_kernel_matches_brute_force(n, scale):
     obs = obstacle_centres(g)
     rng = np.random.default_rng(0)
     pts = rng.uniform(-0.5, 14.5, size=(60, 2))
+    cm = costmap_for(g, 0.0, lattice=False)
+    assert (cm.ox_m, cm.oy_m, cm.res_m) == (-0.5, -0.5, 1.0)
     for x in pts:
         t = rng.uniform(-0.5, 14.5, size=2)
         want = improved_repulsive_force(x, t, obs, 5.0, 2.0, n, scale)
-        got = grid_improved_repulsion(x[0], x[1], t[0], t[1], g.occupied, -0.5, -0.5, 1.0,
-                                      5.0, 2.0, n, scale)
+        got = grid_improved_repulsion(x[0], x[1], t[0], t[1], cm, 5.0, 2.0, n, scale)
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9)
-    assert grid_improved_repulsion(3.0, 4.0, 3.0, 4.0, g.occupied, -0.5, -0.5, 1.0, 5.0, 2.0,
-                                   2.0, 2.0) == (0.0, 0.0)
+    assert grid_improved_repulsion(3.0, 4.0, 3.0, 4.0, cm, 5.0, 2.0, 2.0, 2.0) == (0.0, 0.0)
 
 
 def test_goal_next_to_obstacle_is_reached_where_plain_apf_stops_short():

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from pathfuse import GridMap, plan
+from pathfuse.costmap import costmap_for, make_costmap
 from pathfuse.field.repulsion import boundary_repulsion, grid_repulsion, nearest_obstacle_point
 from pathfuse.generate import shapes_map
 from pathfuse.geometry import point_box_distance
@@ -54,7 +55,7 @@ def test_nearest_obstacle_point_against_brute_force():
     ox, oy = g.origin
     for _ in range(300):
         x, y = rng.uniform(-1.0, 4.0), rng.uniform(0.5, 4.5)
-        d, px, py = nearest_obstacle_point(x, y, g.occupied, ox, oy, 0.2, 1.5)
+        d, px, py = nearest_obstacle_point(x, y, costmap_for(g, 0.0, lattice=False), 1.5)
         want = min(point_box_distance(x, y, ox + c * 0.2, oy + r * 0.2, ox + (c + 1) * 0.2,
                                       oy + (r + 1) * 0.2) for r, c in occ)
         assert d == pytest.approx(min(want, 1.5), abs=1e-12)
@@ -69,14 +70,16 @@ def test_boundary_repulsion_is_the_same_for_a_finely_rasterised_wall_and_matches
         n = int(round(6 / res))
         occ = np.zeros((n, n), dtype=bool)
         occ[:, int(round(3 / res)):] = True
-        forces.append(boundary_repulsion(2.0, 3.0, occ, 0.0, 0.0, res, 5.0, 2.0, 2.0, 0.5))
-        sums.append(grid_repulsion(2.0, 3.0, occ, 0.0, 0.0, res, 5.0, 2.0, 2.0))
+        cm = make_costmap(occ, 0.0, resolution_m=res, lattice=False)
+        forces.append(boundary_repulsion(2.0, 3.0, cm, 5.0, 2.0, 2.0, 0.5))
+        sums.append(grid_repulsion(2.0, 3.0, cm, 5.0, 2.0, 2.0))
     for f in forces:
         assert f == pytest.approx(forces[0], abs=1e-12)
     assert abs(sums[0][0]) > 2.5 * abs(sums[2][0])
     # at the paper's 1 m cells an isolated cell pushes as in the paper along a face normal
     occ = np.zeros((5, 5), dtype=bool)
     occ[2, 3] = True
-    b = boundary_repulsion(2.0, 2.5, occ, 0.0, 0.0, 1.0, 5.0, 2.0, 2.0, 0.5)
-    c = grid_repulsion(2.0, 2.5, occ, 0.0, 0.0, 1.0, 5.0, 2.0, 2.0)
+    cm = make_costmap(occ, 0.0, lattice=False)
+    b = boundary_repulsion(2.0, 2.5, cm, 5.0, 2.0, 2.0, 0.5)
+    c = grid_repulsion(2.0, 2.5, cm, 5.0, 2.0, 2.0)
     assert b == pytest.approx(c)

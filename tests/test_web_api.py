@@ -439,9 +439,11 @@ def test_planners_run_off_the_event_loop():
 
 # --------------------------------------------------------------------------- field
 def test_field_matches_the_planners_kernels(client):
+    from pathfuse.costmap import make_costmap
     from pathfuse.field.repulsion import apf_force, grid_rep_potential
 
     g = pathfuse.load_map("paper", seed=5)
+    cm = make_costmap(g.occupied, 0.0, origin=(-0.5, -0.5), lattice=False)
     d = client.post("/api/field", json={"map": "paper", "seed": 5, "goal": [11, 11],
                                         "planner": "fusion", "params": {"k_rep": 7}}).json()
     assert d["params"] == {"k_att": 40.0, "k_rep": 7.0, "rho0_m": 2.0}
@@ -456,13 +458,12 @@ def test_field_matches_the_planners_kernels(client):
             if g.occupied[r, c]:
                 continue
             x, y = h["xs"][c], h["ys"][r]
-            assert rep[r, c] == pytest.approx(grid_rep_potential(
-                x, y, g.occupied, -0.5, -0.5, 1.0, 7.0, 2.0), rel=1e-6, abs=1e-6)
+            assert rep[r, c] == pytest.approx(grid_rep_potential(x, y, cm, 7.0, 2.0),
+                                              rel=1e-6, abs=1e-6)
             assert att[r, c] == pytest.approx(20.0 * ((x - 11) ** 2 + (y - 11) ** 2), rel=1e-6)
     a = d["arrows"]
     i, j = 3, 4
-    fx, fy = apf_force(a["xs"][j], a["ys"][i], 11.0, 11.0, 40.0, 7.0, 2.0, 2.0, g.occupied,
-                       -0.5, -0.5, 1.0)
+    fx, fy = apf_force(a["xs"][j], a["ys"][i], 11.0, 11.0, 40.0, 7.0, 2.0, 2.0, cm)
     assert a["fx"][i][j] == pytest.approx(fx) and a["fy"][i][j] == pytest.approx(fy)
 
 

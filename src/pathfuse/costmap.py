@@ -21,7 +21,12 @@ checks are numba functions that take it first:
 * :func:`point_clear`, :func:`segment_clear`, :func:`arc_clear` - whether
   that distance is at least ``clear`` (the robot's disc does not touch);
 * :func:`field_distance` - the cheap lower bound of the distance to the
-  occupied squares read from the lattice, and the exact one to the edge.
+  occupied squares read from the lattice, and the exact one to the edge;
+* :func:`move_clear` - the planners' move rule
+  (:func:`pathfuse.geometry.segment_is_clear`): a straight move keeps ``clear``
+  from the occupied squares and stays inside the map, where it may touch the edge
+  (it keeps the radius from it, not the margin); the field controllers' steps,
+  their progress rule and escapes, and the global planners' snapping use it.
 
 :class:`Discs` holds the moving discs a check is made against (centres,
 velocities, speed bounds, radii).
@@ -39,6 +44,10 @@ Examples
 False
 >>> bool(arc_clear(cm, 2.0, 5.0, 0.0, 1.0, 0.5, 1.0, cm.clear_m))
 True
+>>> bool(move_clear(cm, 0.3, 5.0, 0.3, 9.7, cm.clear_m))    # the radius from the edge: a move
+True
+>>> bool(segment_clear(cm, 0.3, 5.0, 0.3, 9.7, cm.clear_m))  # the exact sweep keeps the margin
+False
 >>> make_costmap(occ, -1.0)
 Traceback (most recent call last):
 ...
@@ -54,7 +63,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit
 
-from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
 from pathfuse.grid import GridMap
 from pathfuse.result import ConfigError
 from pathfuse.sweep import arc_static_distance, segment_static_distance
@@ -63,7 +72,8 @@ from pathfuse.validate import number, point, short
 __all__ = [
     "Costmap", "Discs", "make_costmap", "costmap_for", "make_discs", "NO_DISCS",
     "clearance_lattice", "point_distance", "segment_distance", "arc_distance",
-    "point_clear", "segment_clear", "arc_clear", "field_distance", "warmup_costmap",
+    "point_clear", "segment_clear", "arc_clear", "field_distance", "move_clear",
+    "warmup_costmap",
 ]
 
 _MAX_LATTICE_CELLS = 4_000_000
@@ -423,12 +433,22 @@ def field_distance(cm: Costmap, x: float, y: float) -> tuple[float, float]:
     return d, de
 
 
+@njit(cache=True, inline="always")
+def move_clear(cm: Costmap, ax: float, ay: float, bx: float, by: float, clear: float) -> bool:
+    """Whether the straight move ``a-b`` keeps ``clear`` from every occupied square and stays
+    inside the map, at least ``clear`` less :data:`~pathfuse.geometry.MARGIN_FRAC` of a
+    cell from its edge (:func:`pathfuse.geometry.segment_is_clear`: the rule of every
+    planner's and field controller's move; equal ends test a disc at rest)."""
+    return segment_is_clear(ax, ay, bx, by, cm.occ, cm.ox_m, cm.oy_m, cm.res_m, clear)
+
+
 @njit(cache=True)
 def _warm(cm: Costmap) -> float:
     a = point_distance(cm, 0.5, 0.5, 1.0) + segment_distance(cm, 0.5, 0.5, 1.0, 1.0, 1.0)
     b = arc_distance(cm, 0.5, 0.5, 0.0, 1.0, 1.0, 0.1, 0.2, 0.2)
     c = 1.0 if point_clear(cm, 0.5, 0.5, 0.1) and segment_clear(cm, 0.5, 0.5, 1.0, 1.0, 0.1) \
-        and arc_clear(cm, 0.5, 0.5, 0.0, 1.0, 1.0, 0.1, 0.1) else 0.0
+        and arc_clear(cm, 0.5, 0.5, 0.0, 1.0, 1.0, 0.1, 0.1) \
+        and move_clear(cm, 0.5, 0.5, 1.0, 1.0, 0.1) else 0.0
     return a + b + c + field_distance(cm, 0.5, 0.5)[0]
 
 

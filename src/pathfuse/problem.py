@@ -184,24 +184,22 @@ class Problem:
                         "plan through them)")
             return f"{what} ({p[0]:g}, {p[1]:g}) lies in an occupied cell"
         if self.robot_radius_m > 0:
-            from pathfuse.geometry import segment_is_clear
-
-            ox, oy = g.origin
-            from pathfuse.geometry import MARGIN_FRAC
+            from pathfuse.costmap import costmap_for, make_costmap, move_clear
 
             # the clearance every controller keeps (the radius plus a sliver), so that a
             # robot allowed to start or stop here can also move away or arrive
-            clear = self.robot_radius_m + MARGIN_FRAC * g.resolution
-            if not segment_is_clear(p[0], p[1], p[0], p[1], g.occupied, ox, oy, g.resolution,
-                                    clear):
+            cm = costmap_for(g, self.robot_radius_m, lattice=False)
+            clear = cm.clear_m
+            if not move_clear(cm, p[0], p[1], p[0], p[1], clear):
                 x0, y0, x1, y1 = g.bounds
                 edge = min(p[0] - x0, x1 - p[0], p[1] - y0, y1 - p[1]) < self.robot_radius_m
                 unknown = g.meta.get("unknown")
                 if edge:
                     hit = "the map's edge"
                 elif unknown is not None and np_shape(unknown) == g.occupied.shape and \
-                        segment_is_clear(p[0], p[1], p[0], p[1], g.occupied & ~unknown, ox, oy,
-                                         g.resolution, clear):
+                        move_clear(make_costmap(g.occupied & ~unknown, self.robot_radius_m,
+                                                origin=g.origin, resolution_m=g.resolution,
+                                                lattice=False), p[0], p[1], p[0], p[1], clear):
                     hit = ("an unknown cell of the map (unknown cells are blocked; load the "
                            "map with unknown='free' to plan through them)")
                 else:

@@ -24,11 +24,11 @@ def _metric_kernels() -> list:
 
 
 def _world_kernels() -> list:
-    from pathfuse import shield, sweep
+    from pathfuse import costmap, shield, sweep
     from pathfuse.world import obstacles
 
-    return [obstacles._clear, obstacles._bounce_trajectory, sweep.disc_sweep_gaps,
-            sweep.segment_static_distance, shield.shield_unicycle,
+    return [obstacles._bounce_trajectory, costmap.point_distance, costmap.segment_distance,
+            sweep.disc_sweep_gaps, sweep.segment_static_distance, shield.shield_unicycle,
             shield.shield_holonomic]
 
 

@@ -59,6 +59,7 @@ import math
 import numpy as np
 from numba import njit
 
+from pathfuse.costmap import move_clear
 from pathfuse.field.forces import att_force_xy
 from pathfuse.field.motion import (
     HOW_BLOCKED,
@@ -74,7 +75,6 @@ from pathfuse.field.repulsion import (
     grid_improved_repulsion,
     static_repulsion,
 )
-from pathfuse.geometry import segment_is_clear
 from pathfuse.result import (
     CODE_COLLISION,
     CODE_LOCAL_MINIMUM,
@@ -141,7 +141,7 @@ def _goal_reached(buf, n, x, y, s, cm):
     if ex * ex + ey * ey <= tol * tol:
         if x == gx and y == gy:
             return n, CODE_GOAL
-        if segment_is_clear(x, y, gx, gy, cm.occ, cm.ox_m, cm.oy_m, cm.res_m, cm.clear_m):
+        if move_clear(cm, x, y, gx, gy, cm.clear_m):
             buf[n, 0] = gx
             buf[n, 1] = gy
             return n + 1, CODE_GOAL_SNAP
@@ -174,23 +174,19 @@ def _step(x, y, fx, fy, s, cm, margin):
     that touches an obstacle (closer than the robot's radius; for a point any contact).
     """
     step = s.step_m
-    occ = cm.occ
-    ox = cm.ox_m
-    oy = cm.oy_m
-    res = cm.res_m
     clear = cm.clear_m
     radius = cm.radius_m
     if s.safe_step:
         if margin is None:  # no margin (pruned when compiled): the safe step itself
-            return safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
-        return safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, margin)
+            return safe_step(x, y, fx, fy, step, cm, clear)
+        return safe_step_margin(x, y, fx, fy, step, cm, clear, margin)
     fn = math.hypot(fx, fy)
     if not (fn > 0.0) or not math.isfinite(fn):
         return x, y, HOW_BLOCKED
     nx = x + step * fx / fn
     ny = y + step * fy / fn
     touch = radius if radius > 0.0 else 5e-324
-    if segment_is_clear(x, y, nx, ny, occ, ox, oy, res, touch):
+    if move_clear(cm, x, y, nx, ny, touch):
         return nx, ny, HOW_FULL
     return nx, ny, -1
 
@@ -237,10 +233,6 @@ def field_loop(buf, n, max_steps, cm, subs, state, s, ds, dpos, dvel, drad, marg
     k_rep = s.k_rep
     rho0 = s.rho0_m
     stall_d = s.stall_distance_m
-    occ = cm.occ
-    ox = cm.ox_m
-    oy = cm.oy_m
-    res = cm.res_m
     sub_tol = s.subgoal_tolerance_m
     nexp = s.rep_exponent
     scale = s.rep_scale_m
@@ -275,11 +267,10 @@ def field_loop(buf, n, max_steps, cm, subs, state, s, ds, dpos, dvel, drad, marg
         if improved:
             tx = gx if to_goal else sx
             ty = gy if to_goal else sy
-            rx, ry = grid_improved_repulsion(x, y, tx, ty, occ, ox, oy, res, k_rep, rho0, nexp,
-                                             scale, boundary, offset)
+            rx, ry = grid_improved_repulsion(x, y, tx, ty, cm, k_rep, rho0, nexp, scale,
+                                             boundary, offset)
         else:
-            rx, ry = static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0, rho0, boundary,
-                                      offset)
+            rx, ry = static_repulsion(x, y, cm, k_rep, rho0, rho0, boundary, offset)
         fx += rx
         fy += ry
         dfx, dfy = _discs(x, y, fx, fy, cm, ds, dpos, dvel, drad)
@@ -317,10 +308,6 @@ def _escape_move(x, y, tx, ty, s, cm, ds, dpos, dvel, drad):
     within half a step.
     """
     step = s.step_m
-    occ = cm.occ
-    ox = cm.ox_m
-    oy = cm.oy_m
-    res = cm.res_m
     clear = cm.clear_m
     d = math.hypot(tx - x, ty - y)
     dfx = 0.0
@@ -329,15 +316,15 @@ def _escape_move(x, y, tx, ty, s, cm, ds, dpos, dvel, drad):
         dfx, dfy = _discs(x, y, tx - x, ty - y, cm, ds, dpos, dvel, drad)
     if drad is None or (dfx == 0.0 and dfy == 0.0):  # a static run compiles this move only
         nx, ny, landed = straight_move(x, y, tx, ty, step)
-        if segment_is_clear(x, y, nx, ny, occ, ox, oy, res, clear):
+        if move_clear(cm, x, y, nx, ny, clear):
             return nx, ny, True, landed
         return x, y, False, False
     pull = s.k_att * s.r1_m / d
     fx = pull * (tx - x) + dfx
     fy = pull * (ty - y) + dfy
-    nx, ny, how = safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, s.margin_m)
+    nx, ny, how = safe_step_margin(x, y, fx, fy, step, cm, clear, s.margin_m)
     if how == HOW_BLOCKED and s.margin_m > 0.0:  # the margin gives way to the escape
-        nx, ny, how = safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
+        nx, ny, how = safe_step(x, y, fx, fy, step, cm, clear)
     if how == HOW_BLOCKED:
         return x, y, False, False
     return nx, ny, True, math.hypot(tx - nx, ty - ny) <= 0.5 * step
@@ -387,9 +374,6 @@ def fusion_loop(buf, kbuf, n, max_steps, cm, pts, cum, state, s, ds, dpos, dvel,
     r2 = s.r2_m
     backoff_window = s.backoff_window_m
     stall_d = s.stall_distance_m
-    occ = cm.occ
-    ox = cm.ox_m
-    oy = cm.oy_m
     res = cm.res_m
     clear = cm.clear_m
     stall_n = s.stall_steps
@@ -434,9 +418,9 @@ def fusion_loop(buf, kbuf, n, max_steps, cm, pts, cum, state, s, ds, dpos, dvel,
         stalled = False
         blocked = False
         if mode == 0:
-            k = advance_progress(x, y, pts, cum, k, r1, occ, ox, oy, res, clear)
+            k = advance_progress(x, y, pts, cum, k, r1, cm, clear)
             fx, fy, _ = fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0,
-                                     r1, r2, occ, ox, oy, res, boundary, offset)
+                                     r1, r2, cm, boundary, offset)
             dfx, dfy = _discs(x, y, fx, fy, cm, ds, dpos, dvel, drad)
             nx, ny, how = _step(x, y, fx + dfx, fy + dfy, s, cm, margin)
             if how == HOW_BLOCKED:
@@ -504,11 +488,11 @@ def fusion_loop(buf, kbuf, n, max_steps, cm, pts, cum, state, s, ds, dpos, dvel,
             rj = -1
             if escape:
                 if margin is not None and margin > 0.0:  # a way back keeping the margin first
-                    ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox,
-                                         oy, res, clear + margin, kbuf, drive)
+                    ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, cm,
+                                         clear + margin, kbuf, drive)
                 if ri < 0:
-                    ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, occ, ox,
-                                         oy, res, clear, kbuf, drive)
+                    ri, rj = find_rejoin(buf, n, pts, cum, r1 + res, backoff_window, cm,
+                                         clear, kbuf, drive)
             if ri < 0:
                 code = CODE_BLOCKED if blocked else CODE_STALLED
                 break

@@ -15,13 +15,19 @@ The safe step
     clear fraction (bisection, 24 halvings).  If no move of at least
     ``1e-9`` of the step is clear the robot is *blocked* (:data:`HOW_BLOCKED`).
     So a controller built on :func:`safe_step` never collides: every segment
-    it adds passed :func:`~pathfuse.geometry.segment_is_clear`.
+    it adds passed :func:`~pathfuse.costmap.move_clear`.
+
+The map comes as a :class:`~pathfuse.costmap.Costmap` (``cm``); the clearance a
+move keeps is an argument (``clear``: usually ``cm.clear_m``, more to keep a
+safety margin).
 
 Examples
 --------
 >>> import numpy as np
+>>> from pathfuse.costmap import make_costmap
 >>> occ = np.zeros((5, 5), dtype=bool); occ[2, 3] = True   # the square [3, 4] x [2, 3]
->>> x, y, how = safe_step(2.95, 2.5, 1.0, 1.0, 0.1, occ, 0.0, 0.0, 1.0, 1e-6)
+>>> cm = make_costmap(occ, 0.0, lattice=False)
+>>> x, y, how = safe_step(2.95, 2.5, 1.0, 1.0, 0.1, cm, 1e-6)
 >>> round(x, 4), round(y, 4), how   # the diagonal move is blocked: slide along y
 (2.95, 2.5707, 2)
 """
@@ -32,8 +38,8 @@ import math
 
 from numba import njit
 
-from pathfuse.geometry import MARGIN_FRAC, segment_is_clear
-from pathfuse.sweep import segment_static_distance
+from pathfuse.costmap import move_clear, point_distance
+from pathfuse.geometry import MARGIN_FRAC
 
 __all__ = [
     "MARGIN_FRAC",
@@ -53,8 +59,10 @@ HOW_SLIDE = 2
 HOW_SHORT = 3
 
 
-@njit(cache=True)
-def safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear):
+# inlined: a call per step that takes the Costmap cost the apf loop ~9 % of its steps/s
+# on a 256 x 256 map (benchmarks/bench_stepping.py; docs/speed-log.md), and compiles no slower
+@njit(cache=True, inline="always")
+def safe_step(x, y, fx, fy, step, cm, clear):
     """One collision-free move of at most ``step`` along the force ``(fx, fy)``.
 
     Returns ``(x_new, y_new, how)`` with ``how`` one of :data:`HOW_FULL`,
@@ -72,7 +80,7 @@ def safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear):
     uy = fy / fn
     tx = x + step * ux
     ty = y + step * uy
-    if segment_is_clear(x, y, tx, ty, occ, ox, oy, res, clear):
+    if move_clear(cm, x, y, tx, ty, clear):
         return tx, ty, HOW_FULL
     tiny = 1e-9 * step
     sx = step * ux
@@ -80,16 +88,16 @@ def safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear):
     for i in range(2):
         use_x = (abs(ux) >= abs(uy)) == (i == 0)
         if use_x:
-            if abs(sx) > tiny and segment_is_clear(x, y, x + sx, y, occ, ox, oy, res, clear):
+            if abs(sx) > tiny and move_clear(cm, x, y, x + sx, y, clear):
                 return x + sx, y, HOW_SLIDE
         else:
-            if abs(sy) > tiny and segment_is_clear(x, y, x, y + sy, occ, ox, oy, res, clear):
+            if abs(sy) > tiny and move_clear(cm, x, y, x, y + sy, clear):
                 return x, y + sy, HOW_SLIDE
     lo = 0.0
     hi = 1.0
     for _ in range(24):
         mid = 0.5 * (lo + hi)
-        if segment_is_clear(x, y, x + mid * sx, y + mid * sy, occ, ox, oy, res, clear):
+        if move_clear(cm, x, y, x + mid * sx, y + mid * sy, clear):
             lo = mid
         else:
             hi = mid
@@ -109,7 +117,7 @@ def straight_move(x, y, tx, ty, step):
 
 
 @njit(cache=True)
-def safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, margin):
+def safe_step_margin(x, y, fx, fy, step, cm, clear, margin):
     """:func:`safe_step` that keeps a soft safety ``margin`` beyond ``clear`` (ours).
 
     With ``margin > 0`` the move keeps the clearance ``clear + min(margin,
@@ -121,7 +129,7 @@ def safe_step_margin(x, y, fx, fy, step, occ, ox, oy, res, clear, margin):
     itself.
     """
     if margin <= 0.0:
-        return safe_step(x, y, fx, fy, step, occ, ox, oy, res, clear)
-    d = segment_static_distance(occ, ox, oy, res, x, y, x, y, clear + margin)
+        return safe_step(x, y, fx, fy, step, cm, clear)
+    d = point_distance(cm, x, y, clear + margin)
     hi = clear + min(margin, max(d - clear, 0.0)) * (1.0 - 1e-9)
-    return safe_step(x, y, fx, fy, step, occ, ox, oy, res, max(hi, clear))
+    return safe_step(x, y, fx, fy, step, cm, max(hi, clear))

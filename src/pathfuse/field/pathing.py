@@ -1,13 +1,17 @@
 """Progress along a global path and where to rejoin it after a stall (numba).
 
+Whether a path point is in sight is asked of the :class:`~pathfuse.costmap.Costmap`
+(``cm``): :func:`~pathfuse.costmap.move_clear` with the clearance ``clear``.
+
 Examples
 --------
 >>> import numpy as np
+>>> from pathfuse.costmap import make_costmap
 >>> pts = np.array([[0.5, 0.5], [1.5, 0.5], [2.5, 0.5], [3.5, 0.5]])
 >>> polyline_cumlen(pts).tolist()
 [0.0, 1.0, 2.0, 3.0]
->>> occ = np.zeros((2, 4), dtype=bool)
->>> int(advance_progress(2.3, 0.6, pts, polyline_cumlen(pts), 0, 1.0, occ, 0.0, 0.0, 1.0, 1e-6))
+>>> cm = make_costmap(np.zeros((2, 4), dtype=bool), 0.0, lattice=False)
+>>> int(advance_progress(2.3, 0.6, pts, polyline_cumlen(pts), 0, 1.0, cm, 1e-6))
 2
 """
 
@@ -18,7 +22,7 @@ import math
 import numpy as np
 from numba import njit
 
-from pathfuse.geometry import segment_is_clear
+from pathfuse.costmap import move_clear
 
 __all__ = ["polyline_cumlen", "nearest_ahead", "advance_progress", "find_rejoin"]
 
@@ -60,12 +64,12 @@ def nearest_ahead(x, y, pts, cum, k, reach_m):
 
 
 @njit(cache=True)
-def advance_progress(x, y, pts, cum, k, r1_m, occ, ox, oy, res, clear):
+def advance_progress(x, y, pts, cum, k, r1_m, cm, clear):
     """Monotone progress index along a path: the nearest *visible* path point within reach.
 
     Searches the path points after ``k`` whose arc length beyond ``pts[k]`` is
     at most ``|X - pts[k]| + r1_m`` and returns the index of the nearest one
-    that is closer than ``pts[k]`` and in sight (:func:`segment_is_clear`
+    that is closer than ``pts[k]`` and in sight (:func:`~pathfuse.costmap.move_clear`
     from ``X``); ``k`` if there is none.  Never decreases, and never jumps
     through a wall to a later part of the path that passes close by.
     """
@@ -76,7 +80,7 @@ def advance_progress(x, y, pts, cum, k, r1_m, occ, ox, oy, res, clear):
     reach = math.sqrt(dk2) + r1_m
     # the nearest candidate first: usually the only one that needs a sight check
     best = nearest_ahead(x, y, pts, cum, k, reach)
-    if best == k or segment_is_clear(x, y, pts[best, 0], pts[best, 1], occ, ox, oy, res, clear):
+    if best == k or move_clear(cm, x, y, pts[best, 0], pts[best, 1], clear):
         return best
     # the nearest one is out of sight: the nearest visible one
     best = k
@@ -86,7 +90,7 @@ def advance_progress(x, y, pts, cum, k, r1_m, occ, ox, oy, res, clear):
         ex = x - pts[j, 0]
         ey = y - pts[j, 1]
         d2 = ex * ex + ey * ey
-        if d2 < bd2 and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy, res, clear):
+        if d2 < bd2 and move_clear(cm, x, y, pts[j, 0], pts[j, 1], clear):
             bd2 = d2
             best = j
         j += 1
@@ -94,7 +98,7 @@ def advance_progress(x, y, pts, cum, k, r1_m, occ, ox, oy, res, clear):
 
 
 @njit(cache=True)
-def find_rejoin(buf, n, pts, cum, rvis_m, window_m, occ, ox, oy, res, clear, kbuf, drive):
+def find_rejoin(buf, n, pts, cum, rvis_m, window_m, cm, clear, kbuf, drive):
     """Where to rejoin the global path after a stall: a walked point and a path point.
 
     Over the walked points ``buf[i]`` and the path points ``pts[j]`` closer
@@ -153,8 +157,7 @@ def find_rejoin(buf, n, pts, cum, rvis_m, window_m, occ, ox, oy, res, clear, kbu
             d2 = dx * dx + dy * dy
             if d2 < r2:
                 score = math.sqrt(d2) + (total - cum[j]) + sign * back
-                if score < best and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy,
-                                                     res, clear):
+                if score < best and move_clear(cm, x, y, pts[j, 0], pts[j, 1], clear):
                     best = score
                     bi = i
                     bj = j
@@ -186,8 +189,7 @@ def find_rejoin(buf, n, pts, cum, rvis_m, window_m, occ, ox, oy, res, clear, kbu
             d2 = dx * dx + dy * dy
             if d2 < r2:
                 score = cost_i + math.sqrt(d2) + (total - cum[j])
-                if score < best and segment_is_clear(x, y, pts[j, 0], pts[j, 1], occ, ox, oy,
-                                                     res, clear):
+                if score < best and move_clear(cm, x, y, pts[j, 0], pts[j, 1], clear):
                     best = score
                     bi = i
                     bj = j

@@ -1,7 +1,8 @@
 """Forces on a grid (numba): the repulsion of occupied cells and of moving discs.
 
 Obstacle *points* for the forces of eq. 6 are the centres of the occupied
-cells of ``occ, ox, oy, res`` (see :mod:`pathfuse.geometry`).
+cells of the :class:`~pathfuse.costmap.Costmap` ``cm`` (its occupancy, origin
+and resolution; see :mod:`pathfuse.geometry`).
 
 * :func:`grid_repulsion` - eq. 6 summed over the occupied cell centres
   within ``radius_m`` (usually ``rho0_m``; the fusion's ``r2``).  It reads
@@ -29,8 +30,10 @@ cells of ``occ, ox, oy, res`` (see :mod:`pathfuse.geometry`).
 Examples
 --------
 >>> import numpy as np
+>>> from pathfuse.costmap import make_costmap
 >>> occ = np.zeros((5, 5), dtype=bool); occ[2, 3] = True   # one obstacle, centre (3.5, 2.5)
->>> fx, fy = grid_repulsion(2.5, 2.5, occ, 0.0, 0.0, 1.0, 5.0, 2.0, 2.0)
+>>> cm = make_costmap(occ, 0.0, lattice=False)
+>>> fx, fy = grid_repulsion(2.5, 2.5, cm, 5.0, 2.0, 2.0)
 >>> round(fx, 6), round(fy, 6)   # 5 * (1/1 - 1/2) / 1 = 2.5 pointing to -x
 (-2.5, 0.0)
 """
@@ -74,12 +77,18 @@ SIDE_SPEED = 0.05
 """Sideways disc speed (m/s) above which the swerve passes behind the disc."""
 
 
-@njit(cache=True)
-def grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m):
+# inlined: a call per step that takes the Costmap cost the apf loop ~9 % of its steps/s
+# on a 256 x 256 map (benchmarks/bench_stepping.py; docs/speed-log.md), and compiles no slower
+@njit(cache=True, inline="always")
+def grid_repulsion(x, y, cm, k_rep, rho0_m, radius_m):
     """Sum of eq. 6 over occupied cell centres closer than ``radius_m`` to ``(x, y)``.
 
     Reads only the window of cells whose centres can be within ``radius_m``.
     """
+    occ = cm.occ
+    ox = cm.ox_m
+    oy = cm.oy_m
+    res = cm.res_m
     h, w = occ.shape
     rad = radius_m if radius_m < rho0_m else rho0_m
     if rad <= 0.0:
@@ -120,13 +129,17 @@ def grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m):
 
 
 @njit(cache=True)
-def nearest_obstacle_point(x, y, occ, ox, oy, res, cap):
+def nearest_obstacle_point(x, y, cm, cap):
     """The nearest point of an occupied square to ``(x, y)`` within ``cap`` metres (exact).
 
     Returns ``(d, px, py)``; ``d = cap`` and the point ``(x, y)`` when none is
     closer.  Squares are visited ring by ring outwards from the robot's cell,
     and the search stops once a ring lies beyond the best distance or ``cap``.
     """
+    occ = cm.occ
+    ox = cm.ox_m
+    oy = cm.oy_m
+    res = cm.res_m
     h, w = occ.shape
     c0 = int(math.floor((x - ox) / res))
     r0 = int(math.floor((y - oy) / res))
@@ -161,14 +174,14 @@ def nearest_obstacle_point(x, y, occ, ox, oy, res, cap):
 
 
 @njit(cache=True)
-def boundary_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, offset_m):
+def boundary_repulsion(x, y, cm, k_rep, rho0_m, radius_m, offset_m):
     """Eq. 6 on ``d + offset_m``, ``d`` the exact distance to the nearest occupied square,
     within ``min(radius_m, rho0_m)``; away from the nearest point (ours, see the module
     docstring).  Inside a square (``d = 0``) it pushes away from the square's centre."""
     lim = radius_m if radius_m < rho0_m else rho0_m
     if lim <= offset_m:
         return 0.0, 0.0
-    d, px, py = nearest_obstacle_point(x, y, occ, ox, oy, res, lim - offset_m)
+    d, px, py = nearest_obstacle_point(x, y, cm, lim - offset_m)
     deff = d + offset_m
     if deff >= lim:
         return 0.0, 0.0
@@ -176,6 +189,9 @@ def boundary_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, offset_m
         ux = (x - px) / d
         uy = (y - py) / d
     else:
+        ox = cm.ox_m
+        oy = cm.oy_m
+        res = cm.res_m
         cx = ox + (math.floor((x - ox) / res) + 0.5) * res
         cy = oy + (math.floor((y - oy) / res) + 0.5) * res
         n = math.hypot(x - cx, y - cy)
@@ -189,35 +205,34 @@ def boundary_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, offset_m
 
 
 @njit(cache=True)
-def boundary_potential(x, y, occ, ox, oy, res, k_rep, rho0_m, offset_m):
+def boundary_potential(x, y, cm, k_rep, rho0_m, offset_m):
     """Eq. 4 on ``d + offset_m`` (the potential of :func:`boundary_repulsion`)."""
     if rho0_m <= offset_m:
         return 0.0
-    d, _, _ = nearest_obstacle_point(x, y, occ, ox, oy, res, rho0_m - offset_m)
+    d, _, _ = nearest_obstacle_point(x, y, cm, rho0_m - offset_m)
     return rep_potential_d(d + offset_m, k_rep, rho0_m) if d + offset_m < rho0_m else 0.0
 
 
 @njit(cache=True, inline="always")
-def static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, boundary, offset_m):
+def static_repulsion(x, y, cm, k_rep, rho0_m, radius_m, boundary, offset_m):
     """The static map's repulsion: the paper's per-cell sum, or the boundary form."""
     if boundary:
-        return boundary_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, offset_m)
-    return grid_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m)
+        return boundary_repulsion(x, y, cm, k_rep, rho0_m, radius_m, offset_m)
+    return grid_repulsion(x, y, cm, k_rep, rho0_m, radius_m)
 
 
 @njit(cache=True)
-def apf_force(x, y, gx, gy, k_att, k_rep, rho0_m, radius_m, occ, ox, oy, res, boundary=False,
+def apf_force(x, y, gx, gy, k_att, k_rep, rho0_m, radius_m, cm, boundary=False,
               offset_m=BOUNDARY_OFFSET_M):
     """Resultant force of the plain APF at ``(x, y)``: eq. 5 to the goal plus eq. 6."""
     fx, fy = att_force_xy(x, y, gx, gy, k_att)
-    rx, ry = static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, radius_m, boundary,
-                              offset_m)
+    rx, ry = static_repulsion(x, y, cm, k_rep, rho0_m, radius_m, boundary, offset_m)
     return fx + rx, fy + ry
 
 
 @njit(cache=True)
 def fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0_m, r1_m, r2_m,
-                 occ, ox, oy, res, boundary=False, offset_m=BOUNDARY_OFFSET_M):
+                 cm, boundary=False, offset_m=BOUNDARY_OFFSET_M):
     """Resultant force of Algorithm 2 at ``(x, y)``.
 
     Attraction (eq. 5) of the goal plus of every path point ``pts[j]``
@@ -260,16 +275,20 @@ def fusion_force(x, y, gx, gy, pts, cum, k, ahead, k_att, k_rep, rho0_m, r1_m, r
                 fy -= k_att * dy
                 na += 1
             j += 1
-    rx, ry = static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, r2_m, boundary, offset_m)
+    rx, ry = static_repulsion(x, y, cm, k_rep, rho0_m, r2_m, boundary, offset_m)
     return fx + rx, fy + ry, na
 
 
 @njit(cache=True)
-def grid_rep_potential(x, y, occ, ox, oy, res, k_rep, rho0_m):
+def grid_rep_potential(x, y, cm, k_rep, rho0_m):
     """Sum of eq. 4 over the occupied cell centres closer than ``rho0_m`` to ``(x, y)``.
 
     The same window as :func:`grid_repulsion`.
     """
+    occ = cm.occ
+    ox = cm.ox_m
+    oy = cm.oy_m
+    res = cm.res_m
     h, w = occ.shape
     c0 = max(int(math.ceil((x - rho0_m - ox) / res - 0.5)), 0)
     c1 = min(int(math.floor((x + rho0_m - ox) / res - 0.5)), w - 1)
@@ -289,8 +308,8 @@ def grid_rep_potential(x, y, occ, ox, oy, res, k_rep, rho0_m):
 
 
 @njit(cache=True)
-def grid_improved_repulsion(x, y, tx, ty, occ, ox, oy, res, k_rep, rho0_m, n, scale_m,
-                            boundary=False, offset_m=BOUNDARY_OFFSET_M):
+def grid_improved_repulsion(x, y, tx, ty, cm, k_rep, rho0_m, n, scale_m, boundary=False,
+                            offset_m=BOUNDARY_OFFSET_M):
     """The Ge-Cui repulsion at ``(x, y)`` for the target ``(tx, ty)`` on a grid.
 
     ``(rho_g/L)^n`` times :func:`grid_repulsion` plus ``n U (rho_g/L)^(n-1) /
@@ -304,14 +323,13 @@ def grid_improved_repulsion(x, y, tx, ty, occ, ox, oy, res, k_rep, rho0_m, n, sc
         return 0.0, 0.0
     q = rg / scale_m
     s = q**n
-    fx, fy = static_repulsion(x, y, occ, ox, oy, res, k_rep, rho0_m, rho0_m, boundary,
-                              offset_m)
+    fx, fy = static_repulsion(x, y, cm, k_rep, rho0_m, rho0_m, boundary, offset_m)
     fx *= s
     fy *= s
     if boundary:
-        u = boundary_potential(x, y, occ, ox, oy, res, k_rep, rho0_m, offset_m)
+        u = boundary_potential(x, y, cm, k_rep, rho0_m, offset_m)
     else:
-        u = grid_rep_potential(x, y, occ, ox, oy, res, k_rep, rho0_m)
+        u = grid_rep_potential(x, y, cm, k_rep, rho0_m)
     if u > 0.0:
         m = u * n * q ** (n - 1.0) / scale_m / rg
         fx += m * dgx

@@ -26,7 +26,7 @@ from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
-from pathfuse.costmap import costmap_for
+from pathfuse.costmap import costmap_for, move_clear, point_distance
 from pathfuse.field.kernels import (
     CODE_BLOCKED,
     CODE_COLLISION,
@@ -39,7 +39,6 @@ from pathfuse.field.kernels import (
 )
 from pathfuse.field.motion import MARGIN_FRAC
 from pathfuse.field.settings import DiscSettings, FieldSettings, FusionSettings, disc_settings
-from pathfuse.geometry import segment_is_clear
 from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.problem import Problem
 from pathfuse.result import Status
@@ -520,11 +519,7 @@ class FieldController(Controller):
         rb = self.problem.robot
         if rb is None or not rb.is_diff_drive:
             return False
-        from pathfuse.sweep import segment_static_distance
-
-        g = self.problem.grid
-        d = segment_static_distance(g.occupied, float(g.origin[0]), float(g.origin[1]),
-                                    float(g.resolution), x, y, x, y, self.clear_m)
+        d = point_distance(self.costmap, x, y, self.clear_m)
         if d >= self.clear_m:
             return False
         self.costmap = self.costmap._replace(clear_m=d * (1.0 - 1e-12))
@@ -545,8 +540,7 @@ class FieldController(Controller):
         """
         q = sens.positions + sens.velocities * float(self.dt)  # type: ignore[arg-type]
         radii = sens.radii
-        g = self.problem.grid
-        ox, oy = g.origin
+        cm = self.costmap
         step = self.step_m
 
         def gap(px: float, py: float) -> float:
@@ -557,10 +551,7 @@ class FieldController(Controller):
         clear = self.clear_m
         margin = self.problem.clearance_m
         if margin > 0:  # keep the safety margin, or what is left of it (ours)
-            from pathfuse.sweep import segment_static_distance
-
-            d = segment_static_distance(g.occupied, float(ox), float(oy), g.resolution, x, y,
-                                        x, y, clear + margin)
+            d = point_distance(cm, x, y, clear + margin)
             clear = max(clear, clear + min(margin, max(d - clear, 0.0)) * (1.0 - 1e-9))
         if fx == 0.0 and fy == 0.0:
             gx, gy = self.problem.goal
@@ -569,7 +560,7 @@ class FieldController(Controller):
         for k in range(12):
             a = a0 + math.pi / 6 * ((k + 1) // 2) * (1 if k % 2 else -1)
             tx, ty = x + step * math.cos(a), y + step * math.sin(a)
-            if segment_is_clear(x, y, tx, ty, g.occupied, ox, oy, g.resolution, clear):
+            if move_clear(cm, x, y, tx, ty, clear):
                 gp = gap(tx, ty)
                 if gp > best + 1e-9:
                     best, best_xy = gp, (tx, ty)

@@ -94,12 +94,12 @@ def _needs_segments(spec: PlannerSpec, robot_radius_m: float) -> bool:
 
 
 def _warm_segments() -> None:
-    """The robot-disc check of a query's end points (Problem.failure) and of waypoints."""
-    from pathfuse.geometry import segment_is_clear
+    """The robot-disc check of a query's end points (Problem.failure), of the start and goal
+    snapping and of waypoints (:func:`pathfuse.costmap.move_clear`, called from Python)."""
+    from pathfuse.costmap import make_costmap, move_clear
 
-    occ = np.zeros((2, 2), dtype=bool)
-    occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
-    segment_is_clear(0.5, 0.5, 0.5, 0.5, occ, 0.0, 0.0, 1.0, 0.1)
+    move_clear(make_costmap(np.zeros((2, 2), dtype=bool), 0.1, lattice=False), 0.5, 0.5, 0.5,
+               0.5, 0.1)
     _WARM_SEGMENT.append(True)
 
 

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from pathfuse.costmap import costmap_for
 from pathfuse.field.forces import rep_potential_d
 from pathfuse.field.repulsion import apf_force
 from pathfuse.grid import GridMap
@@ -74,8 +75,13 @@ def _rep_samples(rows, cols, occ, ox, oy, res, k_rep, rho0_m):  # pragma: no cov
 
 
 @njit(cache=True, nogil=True)
-def _force_samples(xs, ys, gx, gy, k_att, k_rep, rho0_m, occ, ox, oy, res):  # pragma: no cover
-    """The APF force (eq. 5 + 6) at every lattice point (NaN inside an occupied cell)."""
+def _force_samples(xs, ys, gx, gy, k_att, k_rep, rho0_m, cm):  # pragma: no cover - numba
+    """The APF force (eq. 5 + 6) at every lattice point (NaN inside an occupied cell) of the
+    :class:`~pathfuse.costmap.Costmap` ``cm``."""
+    occ = cm.occ
+    ox = cm.ox_m
+    oy = cm.oy_m
+    res = cm.res_m
     h, w = occ.shape
     fx = np.empty((ys.shape[0], xs.shape[0]), dtype=np.float64)
     fy = np.empty_like(fx)
@@ -89,7 +95,7 @@ def _force_samples(xs, ys, gx, gy, k_att, k_rep, rho0_m, occ, ox, oy, res):  # p
                 fx[i, j] = np.nan
                 fy[i, j] = np.nan
                 continue
-            a, b = apf_force(x, y, gx, gy, k_att, k_rep, rho0_m, rho0_m, occ, ox, oy, res)
+            a, b = apf_force(x, y, gx, gy, k_att, k_rep, rho0_m, rho0_m, cm)
             fx[i, j] = a
             fy[i, j] = b
     return fx, fy
@@ -135,7 +141,7 @@ def potential_field(grid: GridMap, goal: tuple[float, float], k_att: float, k_re
     axc = (ax[:-1] + ax[1:]) / 2 if w > arrows else xs
     ayc = (ay[:-1] + ay[1:]) / 2 if h > arrows else ys
     fx, fy = _force_samples(np.ascontiguousarray(axc), np.ascontiguousarray(ayc), gx, gy,
-                            k_att, k_rep, rho0_m, occ, ox, oy, res)
+                            k_att, k_rep, rho0_m, costmap_for(grid, 0.0, lattice=False))
 
     def finite_max(a: np.ndarray) -> float:
         ok = a[np.isfinite(a)]
@@ -204,7 +210,6 @@ def attractors(problem: Problem, path: np.ndarray, waypoints: np.ndarray, r1_m: 
     >>> attractors(pb, wp[:2], wp, 1.6)
     [[1], [2]]
     """
-    from pathfuse.field.motion import MARGIN_FRAC
     from pathfuse.field.pathing import advance_progress, polyline_cumlen
 
     grid = problem.grid
@@ -214,9 +219,8 @@ def attractors(problem: Problem, path: np.ndarray, waypoints: np.ndarray, r1_m: 
         pts = np.concatenate([pts, [[gx, gy]]])
     pts = np.ascontiguousarray(pts)
     cum = polyline_cumlen(pts)
-    ox, oy = grid.origin
-    res = grid.resolution
-    clear = problem.robot_radius_m + MARGIN_FRAC * res
+    cm = costmap_for(grid, problem.robot_radius_m, lattice=False)
+    clear = cm.clear_m
     r1sq = r1_m * r1_m
     out: list[list[int]] = []
     k = 0
@@ -225,8 +229,7 @@ def attractors(problem: Problem, path: np.ndarray, waypoints: np.ndarray, r1_m: 
         if ahead == "paper-x":
             sel = np.nonzero((pts[:, 0] > x) & (d2 < r1sq))[0]
         else:
-            k = int(advance_progress(float(x), float(y), pts, cum, k, r1_m, grid.occupied,
-                                     ox, oy, res, clear))
+            k = int(advance_progress(float(x), float(y), pts, cum, k, r1_m, cm, clear))
             reach = math.sqrt(float(d2[k])) + r1_m
             j = np.arange(k + 1, pts.shape[0])
             j = j[(cum[j] - cum[k] <= reach) & (d2[j] < r1sq)]

@@ -44,13 +44,13 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse.costmap import costmap_for, point_clear, segment_clear
 from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
 from pathfuse.grid import GridMap
 from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.planners.globals.astar import route as global_route
 from pathfuse.result import ConfigError
 from pathfuse.robot import RobotModel
-from pathfuse.sweep import segment_static_distance
 from pathfuse.validate import short as _shown
 from pathfuse.world.obstacles import (
     LinearObstacle,
@@ -79,15 +79,14 @@ def _pair(v: Any, name: str, lo: float) -> tuple[float, float]:
 
 
 def _disc_ok(grid: GridMap, p: np.ndarray, r: float) -> bool:
-    d = segment_static_distance(grid.occupied, grid.origin[0], grid.origin[1], grid.resolution,
-                                float(p[0]), float(p[1]), float(p[0]), float(p[1]), r)
-    return d >= r
+    """A disc of radius ``r`` at ``p`` is clear of the occupied squares and the outside."""
+    return bool(point_clear(costmap_for(grid, 0.0, lattice=False), float(p[0]), float(p[1]), r))
 
 
 def _leg_ok(grid: GridMap, a: np.ndarray, b: np.ndarray, r: float) -> bool:
-    d = segment_static_distance(grid.occupied, grid.origin[0], grid.origin[1], grid.resolution,
-                                float(a[0]), float(a[1]), float(b[0]), float(b[1]), r)
-    return d >= r
+    """A disc of radius ``r`` moving straight from ``a`` to ``b`` touches nothing static."""
+    return bool(segment_clear(costmap_for(grid, 0.0, lattice=False), float(a[0]), float(a[1]),
+                              float(b[0]), float(b[1]), r))
 
 
 def _random_free_point(rng: np.random.Generator, grid: GridMap, r: float) -> np.ndarray:

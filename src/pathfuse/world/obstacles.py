@@ -53,8 +53,15 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from pathfuse.costmap import (
+    Costmap,
+    costmap_for,
+    make_costmap,
+    point_distance,
+    segment_clear,
+    segment_distance,
+)
 from pathfuse.grid import GridMap
-from pathfuse.sweep import segment_static_distance
 
 __all__ = [
     "LinearObstacle",
@@ -67,16 +74,12 @@ __all__ = [
 
 
 @njit(cache=True)
-def _clear(occ: np.ndarray, ox: float, oy: float, res: float, ax: float, ay: float, bx: float,
-           by: float, radius: float) -> bool:
-    return segment_static_distance(occ, ox, oy, res, ax, ay, bx, by, radius) >= radius
-
-
-@njit(cache=True)
-def _bounce_trajectory(occ: np.ndarray, ox: float, oy: float, res: float, x0: float, y0: float,
-                       vx: float, vy: float, radius: float, dt: float, n_steps: int,
-                       turns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Positions (n+1, 2) and arrival velocities (n+1, 2) of a bouncing disc.
+def _bounce_trajectory(cm: Costmap, x0: float, y0: float, vx: float, vy: float, radius: float,
+                       dt: float, n_steps: int, turns: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Positions (n+1, 2) and arrival velocities (n+1, 2) of a bouncing disc on the map
+    ``cm`` (each move checked with :func:`~pathfuse.costmap.segment_clear` for the disc's
+    ``radius``).
 
     ``turns`` holds one heading change (radians) per tick, applied before the
     tick's move (empty for constant velocity).
@@ -101,11 +104,11 @@ def _bounce_trajectory(occ: np.ndarray, ox: float, oy: float, res: float, x0: fl
             vx, vy = c * vx - s * vy, s * vx + c * vy
         nvx = vx
         nvy = vy
-        ok = (vx == 0.0 and vy == 0.0) or _clear(occ, ox, oy, res, x, y, x + vx * dt,
-                                                  y + vy * dt, radius)
+        ok = (vx == 0.0 and vy == 0.0) or segment_clear(cm, x, y, x + vx * dt, y + vy * dt,
+                                                         radius)
         if not ok:
-            bx = vx != 0.0 and not _clear(occ, ox, oy, res, x, y, x + vx * dt, y, radius)
-            by = vy != 0.0 and not _clear(occ, ox, oy, res, x, y, x, y + vy * dt, radius)
+            bx = vx != 0.0 and not segment_clear(cm, x, y, x + vx * dt, y, radius)
+            by = vy != 0.0 and not segment_clear(cm, x, y, x, y + vy * dt, radius)
             if bx and not by:
                 order = (0, 1, 2)
             elif by and not bx:
@@ -129,8 +132,7 @@ def _bounce_trajectory(occ: np.ndarray, ox: float, oy: float, res: float, x0: fl
                 cand[n, 1] = -lvy
                 n += 1
             for i in range(n):
-                if _clear(occ, ox, oy, res, x, y, x + cand[i, 0] * dt, y + cand[i, 1] * dt,
-                          radius):
+                if segment_clear(cm, x, y, x + cand[i, 0] * dt, y + cand[i, 1] * dt, radius):
                     nvx = cand[i, 0]
                     nvy = cand[i, 1]
                     ok = True
@@ -154,8 +156,10 @@ def _bounce_trajectory(occ: np.ndarray, ox: float, oy: float, res: float, x0: fl
     return pos, vel
 
 
-def _grid_args(grid: GridMap) -> tuple[np.ndarray, float, float, float]:
-    return grid.occupied, float(grid.origin[0]), float(grid.origin[1]), float(grid.resolution)
+def _map_of(grid: GridMap) -> Costmap:
+    """The map's :class:`~pathfuse.costmap.Costmap` without a robot (radius 0, no lattice):
+    each check is given the disc's radius."""
+    return costmap_for(grid, 0.0, lattice=False)
 
 
 @dataclass(frozen=True)
@@ -190,8 +194,7 @@ class LinearObstacle:
         (``velocities[0]`` is the initial velocity): what a sensor sees at
         tick ``k`` without looking ahead.  ``seed`` is unused (no randomness).
         """
-        occ, ox, oy, res = _grid_args(grid)
-        return _bounce_trajectory(occ, ox, oy, res, float(self.position[0]),
+        return _bounce_trajectory(_map_of(grid), float(self.position[0]),
                                   float(self.position[1]), float(self.velocity[0]),
                                   float(self.velocity[1]), float(self.radius), float(dt),
                                   int(n_steps), np.zeros(0))
@@ -328,8 +331,7 @@ class RandomWalkObstacle:
         if self.heading is not None:
             h0 = float(self.heading)
         turns = rng.standard_normal(int(n_steps)) * (self.turn_std * math.sqrt(dt))
-        occ, ox, oy, res = _grid_args(grid)
-        return _bounce_trajectory(occ, ox, oy, res, float(self.position[0]),
+        return _bounce_trajectory(_map_of(grid), float(self.position[0]),
                                   float(self.position[1]), self.speed * math.cos(h0),
                                   self.speed * math.sin(h0), float(self.radius), float(dt),
                                   int(n_steps), turns)
@@ -364,9 +366,9 @@ def obstacle_trajectories(obstacles: tuple[ObstacleSpec, ...] | list[ObstacleSpe
 
 
 def warmup_obstacles() -> None:
-    """Compile (or load from numba's cache) the motion kernel (writeable and read-only maps)."""
-    for ro in (False, True):
-        occ = np.zeros((3, 3), dtype=np.bool_)
-        occ.setflags(write=not ro)
-        _bounce_trajectory(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.0, 0.0, 0.2, 0.5, 4, np.zeros(4))
-        _bounce_trajectory(occ, 0.0, 0.0, 1.0, 1.5, 1.5, 1.0, 0.0, 0.2, 0.5, 4, np.zeros(0))
+    """Compile (or load from numba's cache) the motion kernel and the checks the scenario
+    and the world call from Python (a disc at a point, a straight move)."""
+    cm = make_costmap(np.zeros((3, 3), dtype=np.bool_), 0.0, lattice=False)
+    _bounce_trajectory(cm, 1.5, 1.5, 1.0, 0.0, 0.2, 0.5, 4, np.zeros(4))
+    point_distance(cm, 1.5, 1.5, 0.2)
+    segment_distance(cm, 1.5, 1.5, 1.6, 1.2, 0.2)

@@ -68,11 +68,11 @@ import numpy as np
 import yaml
 
 from pathfuse import validate
+from pathfuse.costmap import costmap_for, point_distance, segment_distance
 from pathfuse.grid import GridMap
 from pathfuse.limits import MAX_SEED, LimitError, env_name, limit
 from pathfuse.result import ConfigError, MapFormatError, PathfuseError
 from pathfuse.robot import RobotModel
-from pathfuse.sweep import segment_static_distance
 from pathfuse.validate import short as _shown
 from pathfuse.world.obstacles import (
     LinearObstacle,
@@ -270,8 +270,10 @@ def _absolute_paths(spec: dict, base: Path) -> dict:
 
 # ---------------------------------------------------------------------- scene checks
 def _disc_clear(grid: GridMap, p: tuple[float, float], r: float) -> bool:
-    return segment_static_distance(grid.occupied, grid.origin[0], grid.origin[1],
-                                   grid.resolution, p[0], p[1], p[0], p[1], max(r, 1e-12)) >= r
+    """A disc of radius ``r`` at ``p`` keeps clear of the occupied squares and the map's
+    outside (asked of the map's :class:`~pathfuse.costmap.Costmap`)."""
+    return point_distance(costmap_for(grid, 0.0, lattice=False), p[0], p[1],
+                          max(r, 1e-12)) >= r
 
 
 def _check_point(grid: GridMap, p: tuple[float, float], r: float, key: str, what: str) -> None:
@@ -329,12 +331,10 @@ def _check_disc(sc: Scenario, i: int, ob: ObstacleSpec) -> None:
         for j, w in enumerate(ob.waypoints):
             _check_point(sc.grid, w, ob.radius, f"{key}.waypoints[{j}]", "the disc")
         poly = ob.polyline()
-        g = sc.grid
+        cm = costmap_for(sc.grid, 0.0, lattice=False)
         for j in range(len(poly) - 1):
             a, b = poly[j], poly[j + 1]
-            d = segment_static_distance(g.occupied, g.origin[0], g.origin[1], g.resolution,
-                                        a[0], a[1], b[0], b[1], ob.radius)
-            if d < ob.radius:
+            if segment_distance(cm, a[0], a[1], b[0], b[1], ob.radius) < ob.radius:
                 jn = (j + 1) % len(ob.waypoints)
                 raise ScenarioError(
                     f"{key}.waypoints: the leg from waypoint {j} to waypoint {jn} is "

@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
+from pathfuse.costmap import costmap_for
 from pathfuse.field.kernels import field_loop
 from pathfuse.field.repulsion import apf_force
 from pathfuse.field.settings import pack_field
@@ -158,12 +159,11 @@ def force_at(grid: GridMap, xy: object, goal: object, params: APFParams | None =
     p = params or APFParams()
     pts = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     gx, gy = (float(v) for v in np.asarray(goal, dtype=np.float64).reshape(2))
-    ox, oy = grid.origin
+    cm = costmap_for(grid, 0.0, lattice=False)
     out = np.empty_like(pts)
     for k in range(pts.shape[0]):
         out[k] = apf_force(pts[k, 0], pts[k, 1], gx, gy, p.k_att, p.k_rep, p.rho0_m, p.rho0_m,
-                           grid.occupied, ox, oy, grid.resolution,
-                           p.static_repulsion == "boundary", p.boundary_offset_m)
+                           cm, p.static_repulsion == "boundary", p.boundary_offset_m)
     return out[0] if np.ndim(cast("ArrayLike", xy)) == 1 else out
 
 

@@ -352,10 +352,8 @@ class DWAController(Controller):
             self._pending_replan = False
             self._replan(x, y)
         self.ticks += 1
-        g = self.problem.grid
         self.k = int(advance_progress(x, y, self.pts, self.cum, self.k, self.reach_m,
-                                      g.occupied, float(g.origin[0]), float(g.origin[1]),
-                                      float(g.resolution), self.clear_m))
+                                      self.costmap, self.clear_m))
         f = self._f_relaxed if self.ticks <= self._relaxed_until else self.f
         n = drad.shape[0]
         ids = np.arange(n) if ids is None else ids

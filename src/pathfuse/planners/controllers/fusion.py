@@ -73,6 +73,7 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse.costmap import costmap_for
 from pathfuse.field.forces import RHO0_M
 from pathfuse.field.kernels import (
     N_S,
@@ -483,10 +484,9 @@ def force_at(grid: GridMap, xy: object, goal: object, global_path: object,
     pts = np.ascontiguousarray(global_path, dtype=np.float64).reshape(-1, 2)
     x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(2))
     gx, gy = (float(v) for v in np.asarray(goal, dtype=np.float64).reshape(2))
-    ox, oy = grid.origin
     fx, fy, _ = fusion_force(x, y, gx, gy, pts, polyline_cumlen(pts), int(progress),
                              _AHEAD[p.ahead], p.k_att, p.k_rep, p.rho0_m, p.r1_m, p.r2_m,
-                             grid.occupied, ox, oy, grid.resolution,
+                             costmap_for(grid, 0.0, lattice=False),
                              p.static_repulsion == "boundary", p.boundary_offset_m)
     return np.array([fx, fy])
 

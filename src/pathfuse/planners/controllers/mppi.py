@@ -328,10 +328,8 @@ class MPPIController(Controller):
                 dsteady: np.ndarray = EVERY_DISC) -> tuple[float, float]:
         if self.replan_every and self.ticks and self.ticks % self.replan_every == 0:
             self._replan(x, y)
-        g = self.problem.grid
         self.k = int(advance_progress(x, y, self.pts, self.cum, self.k, self.reach_m,
-                                      g.occupied, float(g.origin[0]), float(g.origin[1]),
-                                      float(g.resolution), self.clear_m))
+                                      self.costmap, self.clear_m))
         if self.ticks:  # the previous optimal sequence, one tick on
             s = min(self.shift, self.nominal.shape[0])
             self.nominal[:-s] = self.nominal[s:].copy()

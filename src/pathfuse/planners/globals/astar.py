@@ -42,8 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from pathfuse.field.motion import MARGIN_FRAC
-from pathfuse.geometry import segment_is_clear
+from pathfuse.costmap import costmap_for, move_clear
 from pathfuse.grid import GridMap
 from pathfuse.problem import Problem
 from pathfuse.result import ConfigError, Status
@@ -120,7 +119,9 @@ class GlobalPlan:
 def snap_cell(occ: np.ndarray, grid: GridMap, p: tuple[float, float],
               r: float) -> tuple[int, int] | None:
     """A free cell of ``occ`` near ``p`` whose centre a disc of radius ``r`` reaches in a
-    clear straight move (nearest first, within two cells); None if there is none."""
+    clear straight move (nearest first, within two cells; asked of the map's
+    :class:`~pathfuse.costmap.Costmap`, :func:`~pathfuse.costmap.move_clear`); None if there
+    is none."""
     res = grid.resolution
     ox, oy = grid.origin
     c = math.floor((p[0] - ox) / res)
@@ -135,8 +136,9 @@ def snap_cell(occ: np.ndarray, grid: GridMap, p: tuple[float, float],
                 cy = oy + (r2 + 0.5) * res
                 cands.append((math.hypot(cx - p[0], cy - p[1]), r2, c2, cx, cy))
     cands.sort(key=lambda t: (t[0], t[1], t[2]))
+    cm = costmap_for(grid, r, lattice=False)
     for _, r2, c2, cx, cy in cands:
-        if segment_is_clear(p[0], p[1], cx, cy, grid.occupied, ox, oy, res, r):
+        if move_clear(cm, p[0], p[1], cx, cy, r):
             return (r2, c2)
     return None
 
@@ -264,20 +266,17 @@ def _plan_with_margin(problem: Problem, occ: np.ndarray, sc: tuple[int, int],
 
 def _waypoints(problem: Problem, centres: np.ndarray) -> np.ndarray:
     """``[start, centres..., goal]``, leaving out the first and last centres when the straight
-    move past them is clear, and repeated points."""
-    grid = problem.grid
-    ox, oy = grid.origin
-    occ = grid.occupied
-    res = grid.resolution
-    clear = problem.robot_radius_m + MARGIN_FRAC * res
+    move past them is clear (the robot's :class:`~pathfuse.costmap.Costmap`), and repeated
+    points."""
+    cm = costmap_for(problem.grid, problem.robot_radius_m, lattice=False)
+    clear = cm.clear_m
     (sx, sy), (gx, gy) = problem.start, problem.goal
     i0 = 0
     n = centres.shape[0]
-    if n > 1 and segment_is_clear(sx, sy, centres[1, 0], centres[1, 1], occ, ox, oy, res, clear):
+    if n > 1 and move_clear(cm, sx, sy, centres[1, 0], centres[1, 1], clear):
         i0 = 1
     i1 = n
-    if i1 - i0 > 1 and segment_is_clear(centres[i1 - 2, 0], centres[i1 - 2, 1], gx, gy, occ, ox,
-                                        oy, res, clear):
+    if i1 - i0 > 1 and move_clear(cm, centres[i1 - 2, 0], centres[i1 - 2, 1], gx, gy, clear):
         i1 -= 1
     mid = centres[i0:i1]  # distinct cells: a point can repeat only at the two joints
     head = not (mid[0, 0] == sx and mid[0, 1] == sy)

@@ -1,15 +1,16 @@
 """The dwa kernel's exact pruning of samples (:mod:`pathfuse.planners.controllers.dwa_kernel`).
 
-A sample whose every rollout piece the costmap's clearance lattice puts beyond the
-clearance (with room to spare) runs to the horizon and is admissible but for a sensed
-disc within the tick; its cost is then at least the end point's critics
-(:func:`_end_cost`: path distance, goal distance, heading and speed), because every other
-critic adds a non-negative term after them, and floating-point addition is monotone.
-:func:`_clear_bound` finds that state and bound with the pose and the lattice alone (no
-search of the squares, no path-align distance per piece), so the kernel's ``_choose``
-rolls out such samples fully in increasing bound order only while the bound can still
-beat, or tie with an earlier sample, the best so far: the same choice, cost, admissible
-count and passing sides, bit for bit (``tests/test_dwa_exact.py``).
+Where a sample's rollout ends, and whether it is admissible, depends on its static
+distances only down to the clearance: :func:`_probe` finds both with the poses, the
+clearance lattice and a search of the squares capped at the clearance (no obstacle
+critic's wider search, no path-align distance per piece, no disc sweep beyond the tick).
+An admissible sample costs at least its end point's critics (:func:`_end_cost`: path
+distance, goal distance, heading and speed), because every other critic adds a
+non-negative term after them and floating-point addition is monotone; so the kernel's
+``_choose`` rolls out the admissible samples fully in increasing bound order only while
+the bound can still beat, or tie with an earlier sample, the best so far: the same
+choice, cost, admissible count and passing sides, bit for bit
+(``tests/test_dwa_exact.py``).
 """
 
 from __future__ import annotations
@@ -23,20 +24,19 @@ from pathfuse.geometry import MARGIN_FRAC
 from pathfuse.planners.controllers.dwa_checks import (
     _field_bound,
     _path_distance,
+    _segment_distance,
     _straight_pose,
     _sweep_gap,
 )
 from pathfuse.planners.controllers.dwa_route import _wrap
 from pathfuse.sweep import arc_deviation_bound, edge_distance, unicycle_pose
 
-__all__ = ["CLEAR", "INADMISSIBLE", "UNKNOWN", "_clear_bound", "_end_cost"]
+__all__ = ["ADMISSIBLE", "INADMISSIBLE", "_end_cost", "_probe"]
 
-UNKNOWN = -1
-""":func:`_clear_bound`: the lattice cannot tell (the sample is rolled out)."""
 INADMISSIBLE = 0
-""":func:`_clear_bound`: clear of the map, but a sensed disc is hit within the tick."""
-CLEAR = 1
-""":func:`_clear_bound`: admissible, rolled out to the horizon; the bound holds."""
+""":func:`_probe`: the sample is not admissible."""
+ADMISSIBLE = 1
+""":func:`_probe`: the sample is admissible; the bound holds."""
 
 
 @njit(cache=True, inline="always")
@@ -74,17 +74,18 @@ def _end_cost(f, pts, cum, k, jg, bb, x, y, th, v, ex, ey, eth):
 
 
 @njit(cache=True)
-def _clear_bound(cm, f, clear, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel, drad, reach):
-    """The state of one sample (:data:`CLEAR`, :data:`INADMISSIBLE` or :data:`UNKNOWN`) and,
-    when :data:`CLEAR`, a lower bound of its cost (:func:`_end_cost` at the horizon's pose).
+def _probe(cm, nsq, f, clear, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel, drad, reach):
+    """Whether one sample is admissible (:data:`ADMISSIBLE` or :data:`INADMISSIBLE`) and, when
+    it is, a lower bound of its cost: :func:`_end_cost` at the pose where its rollout ends.
 
-    :data:`CLEAR` needs every piece's chord (the same poses as ``_rollout``'s) beyond
-    ``clear`` plus the arc's deviation plus 1e-6 m by the clearance lattice and the map's
-    edge: then no piece of the rollout can come below ``clear`` (its static distance,
-    searched under any cap at least that, is at least that), so it runs to the horizon and
-    only a sensed disc closer than it can come while the robot stops, on a piece starting
-    within the tick, makes it inadmissible (as in ``_rollout``).  ``reach`` is scratch
-    space of one float per disc."""
+    The rollout's poses and its end are ``_rollout``'s (:mod:`.dwa_kernel`), found with less
+    work: a piece whose chord the clearance lattice and the map's edge put beyond ``clear``
+    plus the arc's deviation plus 1e-6 m cannot end the rollout; any other piece's static
+    distance is searched only up to ``clear`` plus the deviation (plus 1e-9 m), which tells
+    whether it is below ``clear`` as the rollout's wider search does (under a smaller cap
+    the distance is the same value, or the cap).  A sensed disc closer than it can come
+    while the robot stops, on a piece starting within the tick, makes the sample
+    inadmissible, as in ``_rollout``.  ``reach`` is scratch space of one float per disc."""
     res = cm.res_m
     dt = f.dt_s
     radius = cm.radius_m
@@ -96,26 +97,31 @@ def _clear_bound(cm, f, clear, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel, 
     cc = clear + e
     capc = cc + 1e-6 * (1.0 + cc)
     tol = capc + 1e-9 * (1.0 + capc)
+    capb = cc + 1e-9 * (1.0 + cc)
     hh, ww = cm.occ.shape
     xmax = cm.ox_m + ww * res
     ymax = cm.oy_m + hh * res
     speed = abs(v)
     amax = f.max_accel_mps2
+    brake = 0.0
+    if math.isfinite(amax) and amax > 0.0:
+        brake = speed * speed / (2.0 * amax)
+    need = speed * dt + brake  # travel before the robot could stand still
     n_disc = drad.shape[0]
     stop_s = dt + (speed / amax if math.isfinite(amax) and amax > 0.0 else 0.0)
     if not f.passive:
         stop_s = 0.0
     for j in range(n_disc):
         reach[j] = math.hypot(dvel[j, 0], dvel[j, 1]) * stop_s
-    hit = False
     straight = w == 0.0
     cmid = math.cos(th + 0.5 * (w * h))
     smid = math.sin(th + 0.5 * (w * h))
     ax = x
     ay = y
-    bx = x
-    by = y
-    bth = th
+    ex = x
+    ey = y
+    eth = th
+    travelled = 0.0
     for i in range(1, n + 1):
         t = min(i * h, horizon)
         if straight:
@@ -123,10 +129,21 @@ def _clear_bound(cm, f, clear, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel, 
         else:
             bx, by, bth = unicycle_pose(x, y, th, v, w, t)
         half = 0.5 * math.sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay))
-        if not (_field_bound(cm, 0.5 * (ax + bx), 0.5 * (ay + by)) - half > tol):
-            return UNKNOWN, 0.0
-        if edge_distance(cm.ox_m, cm.oy_m, xmax, ymax, ax, ay, bx, by, capc, slack) < capc:
-            return UNKNOWN, 0.0
+        if not (_field_bound(cm, 0.5 * (ax + bx), 0.5 * (ay + by)) - half > tol
+                and edge_distance(cm.ox_m, cm.oy_m, xmax, ymax, ax, ay, bx, by, capc,
+                                  slack) >= capc):
+            d = _segment_distance(cm, ax, ay, bx, by, capb, slack, nsq) - e
+            if t <= dt + 1e-12:
+                # the tick itself: the arc (lower bound) and the chord clear
+                if d < clear:
+                    return INADMISSIBLE, np.inf
+                if e > 0.0 and _segment_distance(cm, ax, ay, bx, by, clear, slack,
+                                                 nsq) < clear:
+                    return INADMISSIBLE, np.inf
+            if d < clear:
+                if travelled < need:
+                    return INADMISSIBLE, np.inf  # it could not stop before this collision
+                break
         t0 = t - h if t - h > 0.0 else 0.0
         if t0 <= dt:
             for j in range(n_disc):
@@ -136,9 +153,11 @@ def _clear_bound(cm, f, clear, x, y, th, v, w, pts, cum, k, jg, bb, dpos, dvel, 
                 qby = dpos[j, 1] + dvel[j, 1] * t
                 g0 = _sweep_gap(ax, ay, bx, by, radius, qax, qay, qbx, qby, drad[j]) - e
                 if g0 - reach[j] < 0.0:
-                    hit = True
+                    return INADMISSIBLE, np.inf  # a predicted collision within the tick
+        travelled += abs(v) * (t - (i - 1) * h)
         ax = bx
         ay = by
-    if hit:
-        return INADMISSIBLE, np.inf
-    return CLEAR, _end_cost(f, pts, cum, k, jg, bb, x, y, th, v, bx, by, bth)
+        ex = bx
+        ey = by
+        eth = bth
+    return ADMISSIBLE, _end_cost(f, pts, cum, k, jg, bb, x, y, th, v, ex, ey, eth)

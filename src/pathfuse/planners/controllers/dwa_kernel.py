@@ -19,7 +19,7 @@ from numba import njit
 
 from pathfuse.costmap import Discs, segment_distance
 from pathfuse.geometry import MARGIN_FRAC
-from pathfuse.planners.controllers.dwa_bound import CLEAR, UNKNOWN, _clear_bound, _end_cost
+from pathfuse.planners.controllers.dwa_bound import ADMISSIBLE, _end_cost, _probe
 from pathfuse.planners.controllers.dwa_checks import (
     NearSquares,
     _path_distance,
@@ -517,34 +517,24 @@ def _choose(cm, near, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel,
                 sv[q] = v
                 sw[q] = w
                 q += 1
-    # exact pruning (dwa_bound): the samples the lattice clears are admissible, and cost at
-    # least their end point's critics; rolled out in that bound's order while it can still
-    # beat (or tie with an earlier sample) the best so far; the others are all rolled out.
-    # The least cost wins, the first sample of the order above among equal costs.
-    state = np.empty(ns, dtype=np.int64)
+    # exact pruning (dwa_bound): every sample's admissibility and the least its cost can be
+    # (its end point's critics) first; then the admissible ones rolled out in that bound's
+    # order while it can still beat (or tie with an earlier sample) the best so far.  The
+    # least cost wins, the first sample of the order above among equal costs.
     lb = np.empty(ns)
     for q in range(ns):
-        state[q], lb[q] = _clear_bound(cm, f, clear, x, y, sh[q], sv[q], sw[q], pts, cum, k,
-                                       jg, bb, dpos, dvel, drad, reach)
-        if state[q] == CLEAR:
+        state, lb[q] = _probe(cm, near, f, clear, x, y, sh[q], sv[q], sw[q], pts, cum, k, jg,
+                              bb, dpos, dvel, drad, reach)
+        if state == ADMISSIBLE:
             count += 1
-        else:
-            lb[q] = np.inf
     order = np.argsort(lb)
     bq = ns
-    for r in range(2 * ns):
-        if r < ns:
-            q = order[r]
-            if state[q] != CLEAR:
-                continue
-            if lb[q] > best:
-                continue
-            if lb[q] == best and q > bq:
-                continue
-        else:
-            q = r - ns
-            if state[q] != UNKNOWN:
-                continue
+    for r in range(ns):
+        q = order[r]
+        if not (lb[q] <= best and lb[q] < np.inf):
+            break  # (the inadmissible samples' bound is inf: last)
+        if lb[q] == best and q > bq:
+            continue
         _rollout(cm, near, f, clear, tick.keep_ref_m, x, y, sh[q], sv[q], sw[q], pts, cum, k,
                  jg, bb, dpos, dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
         if out[1] == 1.0 and n_disc > 0:
@@ -556,8 +546,6 @@ def _choose(cm, near, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel,
                     x, y, th, s0[q], s1[q], dt, amax, f.max_yaw_accel_radps2, cm.radius_m,
                     discs))
         if out[1] == 1.0:
-            if r >= ns:
-                count += 1
             c = out[0]
             if c < best or (c == best and c < np.inf and q < bq):
                 best = c

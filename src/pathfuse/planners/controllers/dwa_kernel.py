@@ -341,7 +341,9 @@ def _rollout(cm, nsq, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos,
     if margin > 0.0 and gap < margin:
         obs += 10.0 * (margin - gap) / margin
     # the end point's critics first (dwa_bound._end_cost: the bound the pruning uses), then
-    # the others, each non-negative, in this order
+    # the others in this order: every term added after it must be non-negative, and the
+    # admissibility and end pose above are dwa_bound._probe's (_choose's pruning relies on
+    # both; tests/test_dwa_prune.py)
     out[0] = (_end_cost(f, pts, cum, k, jg, bb, x, y, th, v, ex, ey, eth)
               + f.obstacle_weight * obs + f.moving_weight * dyn
               + f.social_weight * soc + f.side_weight * side_cost + dwc)

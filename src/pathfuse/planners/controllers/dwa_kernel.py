@@ -19,6 +19,7 @@ from numba import njit
 
 from pathfuse.costmap import Discs, segment_distance
 from pathfuse.geometry import MARGIN_FRAC
+from pathfuse.planners.controllers.dwa_bound import ADMISSIBLE, _end_cost, _probe
 from pathfuse.planners.controllers.dwa_checks import (
     NearSquares,
     _path_distance,
@@ -334,37 +335,16 @@ def _rollout(cm, nsq, f, clear, gref, x, y, th, v, w, pts, cum, k, jg, bb, dpos,
         # ours (the dwell critic): the robot may have to stand where the rollout ends
         dwc = f.dwell_weight * dwell_shortfall(ex, ey, tend, dpos, dvel, drad, radius,
                                                f.dwell_s, personal, steady)
-    # the end point against the path near the progress index: its distance to the path and
-    # how much path is left beyond its projection
-    m = pts.shape[0]
-    pd, s_end = _path_distance(pts, cum, k, jg, bb, ex, ey)
-    if pd == np.inf:
-        pd = math.hypot(ex - pts[m - 1, 0], ey - pts[m - 1, 1])
-        s_end = cum[m - 1]
-    left = cum[m - 1] - s_end
-    # the carrot: lookahead_m of path beyond the projection
-    sc = min(s_end + f.lookahead_m, cum[m - 1])
-    j = k
-    while j + 1 < m - 1 and cum[j + 1] < sc:
-        j += 1
-    seg = cum[j + 1] - cum[j] if j + 1 < m else 0.0
-    u = (sc - cum[j]) / seg if seg > 0.0 else 0.0
-    u = min(max(u, 0.0), 1.0)
-    gx = pts[j, 0] + u * (pts[min(j + 1, m - 1), 0] - pts[j, 0])
-    gy = pts[j, 1] + u * (pts[min(j + 1, m - 1), 1] - pts[j, 1])
-    gd = math.hypot(gx - ex, gy - ey)
-    if f.holonomic:
-        hd = math.atan2(gy - y, gx - x)
-        he = abs(_wrap(hd - th)) / math.pi if speed > 0.0 else 0.5
-    else:
-        he = abs(_wrap(math.atan2(gy - ey, gx - ex) - eth)) / math.pi if gd > 1e-9 else 0.0
     gap = dmin - radius
     obs = math.exp(-max(gap, 0.0) / f.inflation_decay_m) if dmin < cap else 0.0
     margin = f.margin_m
     if margin > 0.0 and gap < margin:
         obs += 10.0 * (margin - gap) / margin
-    out[0] = (f.path_weight * pd + f.goal_weight * left + f.heading_weight * he
-              + f.speed_weight * (f.max_speed_mps - v) / f.max_speed_mps
+    # the end point's critics first (dwa_bound._end_cost: the bound the pruning uses), then
+    # the others in this order: every term added after it must be non-negative, and the
+    # admissibility and end pose above are dwa_bound._probe's (_choose's pruning relies on
+    # both; tests/test_dwa_prune.py)
+    out[0] = (_end_cost(f, pts, cum, k, jg, bb, x, y, th, v, ex, ey, eth)
               + f.obstacle_weight * obs + f.moving_weight * dyn
               + f.social_weight * soc + f.side_weight * side_cost + dwc)
     if n_align > 0:
@@ -479,11 +459,28 @@ def _choose(cm, near, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel,
     ty = tick.route_y
     if tx == 0.0 and ty == 0.0:
         tx, ty = route_tangent(pts, k, th)
-    if f.holonomic:
+    holo = f.holonomic
+    lim = amax * dt
+    # the samples, in the order of their ties: the command (s0, s1) and what the rollout
+    # holds (heading sh, speed sv, yaw rate sw)
+    if holo:
         # velocity vectors: speeds x directions (3 w_samples of them, every 8 degrees by
         # default), within |u - u0| <= a dt
-        lim = amax * dt
         ndir = 3 * nw
+        ns = 1 + (nv - 1) * ndir
+    else:
+        ns = nv * (nw + 1)
+        vlo = max(f.min_speed_mps, c0 - amax * dt)
+        vhi = min(vmax, c0 + amax * dt)
+        wlo = max(-f.max_yaw_rate_radps, c1 - f.max_yaw_accel_radps2 * dt)
+        whi = min(f.max_yaw_rate_radps, c1 + f.max_yaw_accel_radps2 * dt)
+    s0 = np.empty(ns)
+    s1 = np.empty(ns)
+    sh = np.full(ns, th)
+    sv = np.empty(ns)
+    sw = np.zeros(ns)
+    q = 0
+    if holo:
         for i in range(nv):
             s = vmax * i / (nv - 1)
             for j in range(ndir if i > 0 else 1):
@@ -502,50 +499,69 @@ def _choose(cm, near, f, clear, tick, x, y, th, c0, c1, pts, cum, k, dpos, dvel,
                             ux *= vmax / sn * (1.0 - 1e-12)
                             uy *= vmax / sn * (1.0 - 1e-12)
                 sp = math.hypot(ux, uy)
-                hd = math.atan2(uy, ux) if sp > 0.0 else th
-                _rollout(cm, near, f, clear, tick.keep_ref_m, x, y, hd, sp, 0.0, pts, cum, k, jg,
-                         bb, dpos, dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
-                if out[1] == 1.0 and n_disc > 0:
-                    out[0] += _passive_penalty(holonomic_stop_disc_gap(
-                        x, y, ux, uy, dt, amax, cm.radius_m, discs))
-                if out[1] == 1.0:
-                    count += 1
-                    if out[0] < best:
-                        best = out[0]
-                        b0 = ux
-                        b1 = uy
-                        chosen[:, :] = sides
+                s0[q] = ux
+                s1[q] = uy
+                sv[q] = sp
+                sh[q] = math.atan2(uy, ux) if sp > 0.0 else th
+                q += 1
+    else:
+        for i in range(nv):
+            # exactly on the window's edges (the world clips anything beyond them)
+            v = vhi if i == nv - 1 else min(max(vlo + (vhi - vlo) * (i / (nv - 1)), vlo), vhi)
+            for j in range(nw + 1):
+                if j < nw:
+                    w = whi if j == nw - 1 else min(max(wlo + (whi - wlo) * (j / (nw - 1)),
+                                                        wlo), whi)
+                else:
+                    w = min(max(0.0, wlo), whi)  # always try going straight
+                s0[q] = v
+                s1[q] = w
+                sv[q] = v
+                sw[q] = w
+                q += 1
+    # exact pruning (dwa_bound): every sample's admissibility and the least its cost can be
+    # (its end point's critics) first; then the admissible ones rolled out in that bound's
+    # order while it can still beat (or tie with an earlier sample) the best so far.  The
+    # least cost wins, the first sample of the order above among equal costs.
+    lb = np.empty(ns)
+    for q in range(ns):
+        state, lb[q] = _probe(cm, near, f, clear, x, y, sh[q], sv[q], sw[q], pts, cum, k, jg,
+                              bb, dpos, dvel, drad, reach)
+        if state == ADMISSIBLE:
+            count += 1
+    order = np.argsort(lb)
+    bq = ns
+    for r in range(ns):
+        q = order[r]
+        if not (lb[q] <= best and lb[q] < np.inf):
+            break  # (the inadmissible samples' bound is inf: last)
+        if lb[q] == best and q > bq:
+            continue
+        _rollout(cm, near, f, clear, tick.keep_ref_m, x, y, sh[q], sv[q], sw[q], pts, cum, k,
+                 jg, bb, dpos, dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
+        if out[1] == 1.0 and n_disc > 0:
+            if holo:
+                out[0] += _passive_penalty(holonomic_stop_disc_gap(
+                    x, y, s0[q], s1[q], dt, amax, cm.radius_m, discs))
+            else:
+                out[0] += _passive_penalty(unicycle_stop_disc_gap(
+                    x, y, th, s0[q], s1[q], dt, amax, f.max_yaw_accel_radps2, cm.radius_m,
+                    discs))
+        if out[1] == 1.0:
+            c = out[0]
+            if c < best or (c == best and c < np.inf and q < bq):
+                best = c
+                bq = q
+                b0 = s0[q]
+                b1 = s1[q]
+                chosen[:, :] = sides
+    if holo:
         if count == 0:  # nothing admissible: slow down as hard as the window allows
             sc = 0.0
             if math.isfinite(lim):
                 sc = max(0.0, 1.0 - lim / max(math.hypot(c0, c1), 1e-300))
             return c0 * sc, c1 * sc, 0, np.inf
         return b0, b1, count, best
-    vlo = max(f.min_speed_mps, c0 - amax * dt)
-    vhi = min(vmax, c0 + amax * dt)
-    wlo = max(-f.max_yaw_rate_radps, c1 - f.max_yaw_accel_radps2 * dt)
-    whi = min(f.max_yaw_rate_radps, c1 + f.max_yaw_accel_radps2 * dt)
-    for i in range(nv):
-        # exactly on the window's edges (the world clips anything beyond them)
-        v = vhi if i == nv - 1 else min(max(vlo + (vhi - vlo) * (i / (nv - 1)), vlo), vhi)
-        for j in range(nw + 1):
-            if j < nw:
-                w = whi if j == nw - 1 else min(max(wlo + (whi - wlo) * (j / (nw - 1)), wlo),
-                                                whi)
-            else:
-                w = min(max(0.0, wlo), whi)  # always try going straight
-            _rollout(cm, near, f, clear, tick.keep_ref_m, x, y, th, v, w, pts, cum, k, jg, bb,
-                     dpos, dvel, drad, out, tx, ty, dside, sides, reach, tick.steady)
-            if out[1] == 1.0 and n_disc > 0:
-                out[0] += _passive_penalty(unicycle_stop_disc_gap(
-                    x, y, th, v, w, dt, amax, f.max_yaw_accel_radps2, cm.radius_m, discs))
-            if out[1] == 1.0:
-                count += 1
-                if out[0] < best:
-                    best = out[0]
-                    b0 = v
-                    b1 = w
-                    chosen[:, :] = sides
     if count == 0:
         # nothing admissible: as slow as possible, turning towards the local goal
         err = _wrap(math.atan2(pts[jg, 1] - y, pts[jg, 0] - x) - th)

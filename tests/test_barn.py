@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -154,9 +155,10 @@ def test_summary_counts_every_episode(barn_run):
 
 
 # --------------------------------------------------------------------- CLI
-def _cli(*args: object, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+def _cli(*args: object, cwd: Path | None = None,
+         env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "pathfuse.cli", *map(str, args)],
-                          capture_output=True, text=True, timeout=600, cwd=cwd)
+                          capture_output=True, text=True, timeout=600, cwd=cwd, env=env)
 
 
 def test_cli_end_to_end_on_two_worlds(tmp_path):
@@ -200,7 +202,9 @@ def test_cli_end_to_end_on_two_worlds(tmp_path):
     (["barn", BARN, "--figure-world", "-1"], "--figure-world"),
 ])
 def test_cli_bad_input(tmp_path, args, fragment):
-    p = _cli(*args, "--out", tmp_path / "o")
+    # an empty numba cache: the error must come before the compile notice, one line
+    p = _cli(*args, "--out", tmp_path / "o",
+             env={**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")})
     assert p.returncode == 2
     assert fragment in p.stderr and "Traceback" not in p.stderr
     assert len(p.stderr.strip().splitlines()) == 1

@@ -123,11 +123,14 @@ def cmd_barn(args: argparse.Namespace) -> int:
                      planners=planners,
                      resolution=base.resolution if args.resolution is None else args.resolution,
                      robot=robot, dt=base.dt if args.dt is None else args.dt, params=params)
+    from pathfuse.studies.barn import find_worlds
+
+    # the folder and the worlds are checked before the compile notice, so that a bad
+    # folder or index is one line on stderr whatever numba's cache holds
+    run_idx = [w.index for w in find_worlds(cfg.directory, cfg.worlds)]
     if args.figure_world is not None:
         from pathfuse.cli.args import CliError
-        from pathfuse.studies.barn import find_worlds
 
-        run_idx = [w.index for w in find_worlds(cfg.directory, cfg.worlds)]
         if args.figure_world not in run_idx:
             shown = ", ".join(map(str, run_idx[:10])) + (", ..." if len(run_idx) > 10 else "")
             raise CliError(f"--figure-world: world {args.figure_world} is not among the worlds "

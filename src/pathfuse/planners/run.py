@@ -98,8 +98,9 @@ def _warm_segments() -> None:
     snapping and of waypoints (:func:`pathfuse.costmap.move_clear`, called from Python)."""
     from pathfuse.costmap import make_costmap, move_clear
 
-    move_clear(make_costmap(np.zeros((2, 2), dtype=bool), 0.1, lattice=False), 0.5, 0.5, 0.5,
-               0.5, 0.1)
+    occ = np.zeros((2, 2), dtype=bool)
+    occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
+    move_clear(make_costmap(occ, 0.1, lattice=False), 0.5, 0.5, 0.5, 0.5, 0.1)
     _WARM_SEGMENT.append(True)
 
 

@@ -184,6 +184,10 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                     "a sensed disc not seen to wander, and so would the command, the first "
                     "step of the best turn-then-go sequence out of the discs' lanes that none "
                     "touches (kept with hysteresis); the shield still checks it; false = off")
+    walker_escape_hold: float = param(
+        0.5, ge=0, le=1000,
+        help="ours, with walker_escape: taken off the cost of the sequence towards the "
+             "heading escaped towards last tick (hysteresis; 0.5 = dwa's HOLD_BONUS)")
     replan_new: bool = param(
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")

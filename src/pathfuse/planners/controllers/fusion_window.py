@@ -242,6 +242,7 @@ class ForceWindow:
         """Ours (the fusion's ``walker_escape``): ``dwa``'s lane escape on the sequences'
         command (:func:`~pathfuse.planners.controllers.dwa_escape.escape_command`)."""
         self.walker_escape_s = float(p.lane_escape_s)
+        self.walker_escape_hold = float(getattr(sp, "walker_escape_hold", 0.5))
         self.walker_escapes = 0
         """Ticks whose command the walker escape replaced."""
         self._escape_heading = math.nan
@@ -422,7 +423,8 @@ class ForceWindow:
         kk = min(max(int(k), 0), pts.shape[0] - 1)
         v, w, hd = escape_command(self.costmap, self.f, self.walker_escape_s, x, y, th,
                                   float(cmd[0]), float(cmd[1]), a0, a1, pts, cum, kk, dpos,
-                                  dvel, drad, self._steady, trust, self._escape_heading)
+                                  dvel, drad, self._steady, trust, self._escape_heading,
+                                  self.walker_escape_hold)
         self._escape_heading = hd
         if hd == hd:
             self.walker_escapes += 1

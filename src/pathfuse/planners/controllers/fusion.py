@@ -185,9 +185,10 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                     "step of the best turn-then-go sequence out of the discs' lanes that none "
                     "touches (kept with hysteresis); the shield still checks it; false = off")
     walker_escape_hold: float = param(
-        0.5, ge=0, le=1000,
+        5.0, ge=0, le=1000,
         help="ours, with walker_escape: taken off the cost of the sequence towards the "
-             "heading escaped towards last tick (hysteresis; 0.5 = dwa's HOLD_BONUS)")
+             "heading escaped towards last tick (hysteresis; dwa's HOLD_BONUS is 0.5, with "
+             "which the escape's heading swung and east_three_lanes seed 0 collided)")
     replan_new: bool = param(
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")

@@ -242,7 +242,7 @@ class ForceWindow:
         """Ours (the fusion's ``walker_escape``): ``dwa``'s lane escape on the sequences'
         command (:func:`~pathfuse.planners.controllers.dwa_escape.escape_command`)."""
         self.walker_escape_s = float(p.lane_escape_s)
-        self.walker_escape_hold = float(getattr(sp, "walker_escape_hold", 0.5))
+        self.walker_escape_hold = float(getattr(sp, "walker_escape_hold", 5.0))
         self.walker_escapes = 0
         """Ticks whose command the walker escape replaced."""
         self._escape_heading = math.nan

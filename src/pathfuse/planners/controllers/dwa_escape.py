@@ -219,14 +219,15 @@ def escape_rollout(cm, f, clear, x, y, th, c0, c1, turn, heading, hold_v, hold_w
 
 @njit(cache=True)
 def escape_command(cm, f, horizon_s, x, y, th, c0, c1, a0, a1, pts, cum, k, dpos, dvel, drad,
-                   steady, trust, last_heading):
+                   steady, trust, last_heading, hold_bonus=HOLD_BONUS):
     """The lane escape (see the module docstring) for ``dwa``'s chosen command ``(a0, a1)``:
     ``(v, w, heading)``, the first step of the best turn-then-go sequence and the heading it
     turns to, when it replaces ``(a0, a1)``; ``(a0, a1, nan)`` otherwise.  ``last_heading`` is
     the heading escaped towards last tick (nan: none); ``trust`` the discs whose contact with
     the robot standing sets the escape off (empty: every disc).  ``f`` is ``dwa``'s
     :class:`~pathfuse.planners.controllers.dwa_kernel.DwaSettings` (its dwell critic at least
-    :data:`ESCAPE_DWELL_S` long)."""
+    :data:`ESCAPE_DWELL_S` long); ``hold_bonus`` is taken off the cost of the sequence
+    towards ``last_heading`` (``dwa``: :data:`HOLD_BONUS`)."""
     nan = math.nan
     if drad.shape[0] == 0:
         return a0, a1, nan
@@ -264,7 +265,7 @@ def escape_command(cm, f, horizon_s, x, y, th, c0, c1, a0, a1, pts, cum, k, dpos
             continue  # touched too: not an escape
         c = out[0]
         if last_heading == last_heading and abs(_wrap(hd - last_heading)) < 1e-9:
-            c -= HOLD_BONUS
+            c -= hold_bonus
         if c < best:
             best = c
             bv = out[2]

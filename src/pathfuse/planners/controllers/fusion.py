@@ -177,6 +177,18 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                     "the safest whose first command the shield passes unchanged (kept with "
                     "hysteresis) replaces it (planners/controllers/evade.py); off by "
                     "default: no gain measured (docs/results/dynamic.md)")
+    walker_escape: bool = param(
+        False, help="ours (diff-drive robot online, among_discs='mppi'): dwa's lane escape "
+                    "(planners/controllers/dwa_escape.py) on the sequences' command: while "
+                    "the robot standing would be touched within dwa's lane_escape_s (4 s) by "
+                    "a sensed disc not seen to wander, and so would the command, the first "
+                    "step of the best turn-then-go sequence out of the discs' lanes that none "
+                    "touches (kept with hysteresis); the shield still checks it; false = off")
+    walker_escape_hold: float = param(
+        5.0, ge=0, le=1000,
+        help="ours, with walker_escape: taken off the cost of the sequence towards the "
+             "heading escaped towards last tick (hysteresis; dwa's HOLD_BONUS is 0.5, with "
+             "which the escape's heading swung and east_three_lanes seed 0 collided)")
     replan_new: bool = param(
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")

@@ -237,6 +237,15 @@ class ForceWindow:
             from pathfuse.planners.controllers.evade import Evader
 
             self.evader = Evader(problem.goal, dt=float(dt))
+        self.walker_escape = among_discs == "mppi" and bool(getattr(sp, "walker_escape",
+                                                                    False))
+        """Ours (the fusion's ``walker_escape``): ``dwa``'s lane escape on the sequences'
+        command (:func:`~pathfuse.planners.controllers.dwa_escape.escape_command`)."""
+        self.walker_escape_s = float(p.lane_escape_s)
+        self.walker_escape_hold = float(getattr(sp, "walker_escape_hold", 5.0))
+        self.walker_escapes = 0
+        """Ticks whose command the walker escape replaced."""
+        self._escape_heading = math.nan
 
     def relax(self, seconds: float) -> None:
         """Recovery (ours, as Nav2's clear-costmap): no obstacle critic and no margin for
@@ -328,7 +337,8 @@ class ForceWindow:
         if abs(err) > self.rotate_rad and not among:
             return self._rotate(err)
         if self.among_discs == "mppi" and drad.shape[0] > 0:
-            return self._sequences(obs, path, kk, pts, k, dpos, dvel, drad)
+            return self._sequences(obs, path, kk, pts, cum, k, dpos, dvel, drad)
+        self._escape_heading = math.nan  # the walker escape's hysteresis ends with the discs
         f = self.f_relaxed if self.ticks <= self.relaxed_until else self.f
         # the keep critic's reference: the gap the A* path keeps ahead (the local path is
         # the field's streamline, which may graze)
@@ -359,8 +369,8 @@ class ForceWindow:
         keep = np.array([int(i) not in self.steady.wanders for i in ids], dtype=np.float64)
         return np.ascontiguousarray(dvel * keep[:, None]) if keep.size else dvel
 
-    def _sequences(self, obs: Any, path: np.ndarray, kk: int, pts: np.ndarray, k: int,
-                   dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray) -> np.ndarray:
+    def _sequences(self, obs: Any, path: np.ndarray, kk: int, pts: np.ndarray, cum: np.ndarray,
+                   k: int, dpos: np.ndarray, dvel: np.ndarray, drad: np.ndarray) -> np.ndarray:
         """Among sensed discs (``among_discs="mppi"``, ours): the command of MPPI's sampled
         control sequences (:mod:`pathfuse.planners.controllers.mppi`, its defaults and
         critics) tracking Algorithm 2's local path from the robot, then the A* path beyond
@@ -390,7 +400,36 @@ class ForceWindow:
             # ours (evade, :mod:`pathfuse.planners.controllers.evade`): the plan stops in a
             # disc's predicted sweep; an escape out of every sensed disc's sweep instead
             a0, a1 = float(m.nominal[0, 0]), float(m.nominal[0, 1])
+        if self.walker_escape:
+            a0, a1 = self._walker_escape(obs, x, y, th, float(a0), float(a1), pts, cum, k,
+                                         dpos, dvel, drad)
         return np.array([a0, a1])
+
+    def _walker_escape(self, obs: Any, x: float, y: float, th: float, a0: float, a1: float,
+                       pts: np.ndarray, cum: np.ndarray, k: int, dpos: np.ndarray,
+                       dvel: np.ndarray, drad: np.ndarray) -> tuple[float, float]:
+        """Ours (the fusion's ``walker_escape``): ``dwa``'s lane escape
+        (:func:`~pathfuse.planners.controllers.dwa_escape.escape_command`) applied to the
+        sequences' command ``(a0, a1)`` as ``dwa`` applies it to its own: set off only by
+        the discs not seen to wander (:class:`~pathfuse.planners.controllers.social.SteadyDiscs`),
+        the heading escaped towards last tick kept (hysteresis), the sequences scored against
+        the A* path from the robot's progress with the window's settings (``dwa``'s defaults
+        and the fusion's social critics).  The command still passes the shield."""
+        from pathfuse.planners.controllers.dwa_escape import escape_command
+
+        ids = disc_ids(obs, drad.shape[0])
+        trust = np.array([int(i) not in self.steady.wanders for i in ids], dtype=np.bool_)
+        cmd = obs.command
+        kk = min(max(int(k), 0), pts.shape[0] - 1)
+        v, w, hd = escape_command(self.costmap, self.f, self.walker_escape_s, x, y, th,
+                                  float(cmd[0]), float(cmd[1]), a0, a1, pts, cum, kk, dpos,
+                                  dvel, drad, self._steady, trust, self._escape_heading,
+                                  self.walker_escape_hold)
+        self._escape_heading = hd
+        if hd == hd:
+            self.walker_escapes += 1
+            return float(v), float(w)
+        return a0, a1
 
     def _rotate(self, err: float) -> np.ndarray:
         rb = self.problem.robot

@@ -39,7 +39,8 @@ def client():
     # the server's other limits at their defaults, but a request budget that a first
     # request's compilation on an empty numba cache cannot exceed on a loaded machine
     # (the default 8 s of wall time did, at load 8-13 on 2 cores: a 503 instead of the
-    # answer); the budget itself is tested with apps of their own (test_a_request_over_the_budget_is_503)
+    # answer); the budget itself is tested with apps of their own
+    # (test_a_request_over_the_budget_is_503)
     with TestClient(create_app(limits=Limits(time_budget_s=120.0)), base_url=BASE) as c:
         yield c
 

@@ -95,12 +95,17 @@ def _needs_segments(spec: PlannerSpec, robot_radius_m: float) -> bool:
 
 def _warm_segments() -> None:
     """The robot-disc check of a query's end points (Problem.failure), of the start and goal
-    snapping and of waypoints (:func:`pathfuse.costmap.move_clear`, called from Python)."""
+    snapping and of waypoints (:func:`pathfuse.costmap.move_clear`, called from Python), and
+    :func:`pathfuse.geometry.segment_is_clear` as dwa's and mppi's offline goal test call it."""
     from pathfuse.costmap import make_costmap, move_clear
+    from pathfuse.geometry import segment_is_clear
 
     occ = np.zeros((2, 2), dtype=bool)
     occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
     move_clear(make_costmap(occ, 0.1, lattice=False), 0.5, 0.5, 0.5, 0.5, 0.1)
+    # dwa's and mppi's offline goal test call it from Python too: on a warm cache, loading
+    # move_clear does not load it
+    segment_is_clear(0.5, 0.5, 0.5, 0.5, occ, 0.0, 0.0, 1.0, 0.1)
     _WARM_SEGMENT.append(True)
 
 

@@ -377,8 +377,7 @@ class DWAController(Controller):
             # only by discs not seen to wander (social.SteadyDiscs, as the fusion's lanes)
             trust = EVERY_DISC
             if p.lane_escape_steady:
-                wanders = self.steady.wanders
-                trust = np.array([int(i) not in wanders for i in ids], dtype=np.bool_)
+                trust = self.steady.trusted(ids)
             v, w, hd = escape_command(self.costmap, f, p.lane_escape_s, x, y, th, c0, c1,
                                       float(a0), float(a1), self.pts, self.cum, self.k, dpos,
                                       dvel, drad, tick.steady, trust, self._escape_heading)

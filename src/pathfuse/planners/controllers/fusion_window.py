@@ -366,7 +366,7 @@ class ForceWindow:
         not steady, :class:`~pathfuse.planners.controllers.social.SteadyDiscs`): the lanes
         of ``replan_lane_s`` are those of the discs that may keep their velocity (ours)."""
         ids = disc_ids(obs, dvel.shape[0])
-        keep = np.array([int(i) not in self.steady.wanders for i in ids], dtype=np.float64)
+        keep = self.steady.trusted(ids).astype(np.float64)
         return np.ascontiguousarray(dvel * keep[:, None]) if keep.size else dvel
 
     def _sequences(self, obs: Any, path: np.ndarray, kk: int, pts: np.ndarray, cum: np.ndarray,
@@ -418,7 +418,7 @@ class ForceWindow:
         from pathfuse.planners.controllers.dwa_escape import escape_command
 
         ids = disc_ids(obs, drad.shape[0])
-        trust = np.array([int(i) not in self.steady.wanders for i in ids], dtype=np.bool_)
+        trust = self.steady.trusted(ids)
         cmd = obs.command
         kk = min(max(int(k), 0), pts.shape[0] - 1)
         v, w, hd = escape_command(self.costmap, self.f, self.walker_escape_s, x, y, th,

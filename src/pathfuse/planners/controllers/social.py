@@ -238,6 +238,11 @@ class SteadyDiscs:
                         if len(hist[int(i)]) > self.n and not out[j]}
         return out
 
+    def trusted(self, ids: np.ndarray) -> np.ndarray:
+        """A boolean mask of the discs ``ids`` not seen to wander at the last update: those
+        whose constant-velocity lanes the fusion's replanned lanes and the lane escapes trust."""
+        return np.array([int(i) not in self.wanders for i in ids], dtype=np.bool_)
+
 
 def disc_ids(obs: Any, n: int) -> np.ndarray:
     """The sensed discs' identities (their indices in the scenario), or ``0..n-1`` when the

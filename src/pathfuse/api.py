@@ -130,7 +130,7 @@ def plan(
     # plan_query's body without its Planned tuple (the same checks in the same order)
     spec = get_planner(planner)
     cfg = make_params(spec, params)
-    if robot_radius_m is None:
-        robot_radius_m = getattr(robot, "radius_m", 0.0)
+    if robot_radius_m is None:  # None has no radius_m: no attribute look-up that fails
+        robot_radius_m = 0.0 if robot is None else getattr(robot, "radius_m", 0.0)
     return solve(spec, Problem.create(grid, start, goal, robot_radius_m, budget, clearance_m,
                                       robot), cfg)

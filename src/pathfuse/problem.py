@@ -145,10 +145,19 @@ class Problem:
                                   f"robot_radius_m ({float(r):g})")
         ox, oy = grid.origin
         res = grid.resolution
-        return cls._made(grid, s, g, float(r), budget,
-                         (math.floor((s[1] - oy) / res), math.floor((s[0] - ox) / res)),
-                         (math.floor((g[1] - oy) / res), math.floor((g[0] - ox) / res)),
-                         c, robot)
+        # _made's body, written out (a query's every call counts: issue 21)
+        obj = object.__new__(cls)
+        d = obj.__dict__
+        d["grid"] = grid
+        d["start"] = s
+        d["goal"] = g
+        d["robot_radius_m"] = float(r)
+        d["budget"] = budget
+        d["start_cell"] = (math.floor((s[1] - oy) / res), math.floor((s[0] - ox) / res))
+        d["goal_cell"] = (math.floor((g[1] - oy) / res), math.floor((g[0] - ox) / res))
+        d["clearance_m"] = c
+        d["robot"] = robot
+        return obj
 
     @classmethod
     def _made(cls, grid: GridMap, start: tuple[float, float], goal: tuple[float, float],
@@ -243,6 +252,7 @@ class Problem:
         """The same problem from another start (a replanning robot's position)."""
         ox, oy = self.grid.origin
         res = self.grid.resolution
-        return Problem(self.grid, start, self.goal, self.robot_radius_m, self.budget,
-                       (math.floor((start[1] - oy) / res), math.floor((start[0] - ox) / res)),
-                       self.goal_cell, self.clearance_m, self.robot)
+        return Problem._made(self.grid, start, self.goal, self.robot_radius_m, self.budget,
+                             (math.floor((start[1] - oy) / res),
+                              math.floor((start[0] - ox) / res)),
+                             self.goal_cell, self.clearance_m, self.robot)

@@ -21,10 +21,10 @@ import numpy as np
 
 from pathfuse.metrics import PlanInfo
 from pathfuse.planners.base import Controller, Observed
-from pathfuse.planners.globals.astar import GlobalPlan, found_message, searched
+from pathfuse.planners.globals.astar import GlobalPlan, searched
 from pathfuse.planners.globals.builtin import _astar as _builtin_astar
 from pathfuse.planners.globals.builtin import run_global
-from pathfuse.planners.registry import PlannerSpec, get_global_planner
+from pathfuse.planners.registry import GLOBAL_PLANNERS, PlannerSpec
 from pathfuse.problem import Problem
 from pathfuse.result import ConfigError, PlanResult, Status, path_length
 from pathfuse.search.astar import HEURISTICS, get_searcher
@@ -146,9 +146,10 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
         return res if res.planner == spec.name else _renamed(res, spec.name)
     assert ctrl_cls is not None
     if gname == "astar" and _LANE and problem.robot_radius_m == 0 and \
-            problem.clearance_m == 0 and problem.robot is None and _as_planned(ctrl_cls):
-        gs = get_global_planner("astar")
-        if gs.func is _builtin_astar and gs.plugin is None:  # not a plug-in's astar
+            problem.clearance_m == 0 and problem.robot is None and \
+            (_AS_PLANNED.get(ctrl_cls) or _as_planned(ctrl_cls)):
+        gs = GLOBAL_PLANNERS.get("astar")  # registered by now: warm() looked it up
+        if gs is not None and gs.func is _builtin_astar and gs.plugin is None:  # not a plug-in
             return _astar_as_planned(spec, problem, params)
     deadline = (time.perf_counter() + budget.time_limit_s
                 if budget.time_limit_s is not None else None)
@@ -226,10 +227,11 @@ def _astar_as_planned(spec: PlannerSpec, problem: Problem, params: Any) -> PlanR
     length = res.cost * res_m
     info = PlanInfo(cells=res.cells, cost_cells=length / res_m, heuristic=heuristic,
                     corner_cutting=cut)
-    info.bind(grid, res.points, problem.robot_radius_m)
+    info._bound = (grid, res.points, problem.robot_radius_m)  # bind()'s body (a float)
+    # found_message's text, written out
     return PlanResult._made(Status.SUCCESS, res.points, length, elapsed + 0.0, spec.name,
-                            res.expansions, 0, found_message(len(res.cells), length,
-                                                             res.expansions), info)
+                            res.expansions, 0, f"path through {len(res.cells)} cells, "
+                            f"{length:.6g} m, {res.expansions} expansions", info)
 
 
 def _renamed(res: PlanResult, name: str) -> PlanResult:

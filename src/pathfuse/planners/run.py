@@ -227,7 +227,7 @@ def _astar_as_planned(spec: PlannerSpec, problem: Problem, params: Any) -> PlanR
     length = res.cost * res_m
     info = PlanInfo(cells=res.cells, cost_cells=length / res_m, heuristic=heuristic,
                     corner_cutting=cut)
-    info._bound = (grid, res.points, problem.robot_radius_m)  # bind()'s body (a float)
+    info._bound = (grid, res.points, float(problem.robot_radius_m))  # bind()'s body
     # found_message's text, written out
     return PlanResult._made(Status.SUCCESS, res.points, length, elapsed + 0.0, spec.name,
                             res.expansions, 0, f"path through {len(res.cells)} cells, "

@@ -127,5 +127,10 @@ def plan(
     ...        .info["astar_length"], 4) for gp in ("astar", "thetastar")]
     [6.8284, 6.6056]
     """
-    return plan_query(grid, start, goal, planner, params, robot_radius_m=robot_radius_m,
-                      clearance_m=clearance_m, robot=robot, budget=budget).result
+    # plan_query's body without its Planned tuple (the same checks in the same order)
+    spec = get_planner(planner)
+    cfg = make_params(spec, params)
+    if robot_radius_m is None:  # None has no radius_m: no attribute look-up that fails
+        robot_radius_m = 0.0 if robot is None else getattr(robot, "radius_m", 0.0)
+    return solve(spec, Problem.create(grid, start, goal, robot_radius_m, budget, clearance_m,
+                                      robot), cfg)

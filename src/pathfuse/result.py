@@ -255,6 +255,26 @@ class PlanResult:
     def __bool__(self) -> bool:
         return self.status is Status.SUCCESS
 
+    @classmethod
+    def _made(cls, status: Status, path: np.ndarray, length: float, time_s: float,
+              planner: str, expansions: int, iterations: int, message: str,
+              info: dict[str, Any]) -> PlanResult:
+        """``cls(...)`` with every field given: stored as the frozen dataclass's ``__init__``
+        stores them, without its ``object.__setattr__`` call per field (about 1 us of a
+        tiny ``plan()``'s 17 us; :func:`pathfuse.planners.run.solve` builds its results so)."""
+        obj = object.__new__(cls)
+        d = obj.__dict__
+        d["status"] = status
+        d["path"] = path
+        d["length"] = length
+        d["time_s"] = time_s
+        d["planner"] = planner
+        d["expansions"] = expansions
+        d["iterations"] = iterations
+        d["message"] = message
+        d["info"] = info
+        return obj
+
     @property
     def success(self) -> bool:
         return self.status is Status.SUCCESS

@@ -215,9 +215,12 @@ def point(value: Any, key: str,
     ...
     pathfuse.result.ConfigError: goal[1]: must be a finite number, got inf
     """
-    if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):
-        value = value.tolist()
-    if not isinstance(value, (list, tuple)) or len(value) != 2:
+    if type(value) is not tuple:  # a tuple (plan()'s usual case) has no tolist to look up
+        if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):
+            value = value.tolist()
+        if not isinstance(value, (list, tuple)):
+            raise _fail(key, "two numbers [x, y]", value, error)
+    if len(value) != 2:
         raise _fail(key, "two numbers [x, y]", value, error)
     x, y = value
     if type(x) is float and type(y) is float and math.isfinite(x) and math.isfinite(y):

@@ -193,6 +193,13 @@ class Controller:
         """Drive to the goal on the static map (``deadline``: a ``perf_counter`` value)."""
         raise NotImplementedError
 
+    @classmethod
+    def run_offline(cls, problem: Problem, params: Any, plan: Any,
+                    deadline: float | None) -> Outcome:
+        """What :func:`pathfuse.plan` asks: :meth:`run` of a new controller (one whose
+        offline answer needs no instance, such as the path follower's, overrides this)."""
+        return cls(problem, params, plan).run(deadline)
+
     def act(self, obs: Observed) -> np.ndarray:  # pragma: no cover - abstract
         """The velocity ``(vx, vy)`` for this tick."""
         raise NotImplementedError

@@ -315,7 +315,8 @@ def register_global_planner(name: str, func: Callable[..., Any], description: st
 def get_global_planner(name: str) -> GlobalPlannerSpec:
     """The global planner registered under ``name``; :class:`ConfigError` listing the
     choices otherwise."""
-    spec = GLOBAL_PLANNERS.get(name) if isinstance(name, str) and _LOADED else None
+    spec = GLOBAL_PLANNERS.get(name) if isinstance(name, str) and \
+        (_LOADED or _GLOBAL_HOME.get(name) in _HOMES_DONE) else None
     if spec is not None:
         return spec
     _load_for(name, _GLOBAL_HOME)
@@ -380,7 +381,9 @@ def planner_names() -> list[str]:
 def get_planner(name: str) -> PlannerSpec:
     """The spec registered under ``name`` (or an alias); :class:`ConfigError` listing the
     choices otherwise."""
-    spec = REGISTRY.get(name) if isinstance(name, str) and _LOADED else None
+    # resolved before (its module imported, or every one): a look-up, without a call
+    spec = REGISTRY.get(name) if isinstance(name, str) and \
+        (_LOADED or _HOME.get(name) in _HOMES_DONE) else None
     if spec is not None:
         return spec
     _load_for(name, _HOME)

@@ -21,11 +21,14 @@ import numpy as np
 
 from pathfuse.metrics import PlanInfo
 from pathfuse.planners.base import Controller, Observed
-from pathfuse.planners.globals.astar import GlobalPlan
+from pathfuse.planners.globals.astar import GlobalPlan, searched
+from pathfuse.planners.globals.builtin import _astar as _builtin_astar
 from pathfuse.planners.globals.builtin import run_global
-from pathfuse.planners.registry import PlannerSpec
+from pathfuse.planners.registry import GLOBAL_PLANNERS, PlannerSpec
 from pathfuse.problem import Problem
-from pathfuse.result import PlanResult, Status, path_length
+from pathfuse.result import ConfigError, PlanResult, Status, path_length
+from pathfuse.search.astar import HEURISTICS, get_searcher
+from pathfuse.validate import short as _shown
 
 __all__ = ["solve", "start_online", "warm", "warm_query", "Stopped", "PlanInfo"]
 
@@ -122,11 +125,17 @@ def _astar_info(gp: GlobalPlan | None) -> dict[str, Any]:
 
 def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     """Plan ``problem`` with ``spec`` offline (the body of :func:`pathfuse.plan`)."""
-    segments = _needs_segments(spec, problem.robot_radius_m)
     bad = problem.failure()
     if bad is not None:
         return PlanResult(bad[0], planner=spec.name, message=bad[1])
-    warm(spec, params=params, segments=segments, margin=problem.clearance_m > 0)
+    gname = getattr(params, "global_planner", None) or spec.global_planner  # global_planner_of
+    ctrl_cls = spec.controller
+    # _needs_segments, written out
+    segments = problem.robot_radius_m > 0 or ctrl_cls is None or not ctrl_cls.search_budget
+    margin = problem.clearance_m > 0
+    if (spec.name, gname, False, False, margin) not in _WARM or \
+            (segments and not _WARM_SEGMENT):  # warm()'s own test, without its call
+        warm(spec, params=params, segments=segments, margin=margin)
     budget = problem.budget
     if spec.function is not None:
         res = spec.function(problem.grid, np.array(problem.start), np.array(problem.goal),
@@ -135,12 +144,16 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
             raise TypeError(f"planner {spec.name!r} returned {type(res).__name__}, "
                             "not a PlanResult")
         return res if res.planner == spec.name else _renamed(res, spec.name)
-    ctrl_cls = spec.controller
     assert ctrl_cls is not None
+    if gname == "astar" and _LANE and problem.robot_radius_m == 0 and \
+            problem.clearance_m == 0 and problem.robot is None and \
+            (_AS_PLANNED.get(ctrl_cls) or _as_planned(ctrl_cls)):
+        gs = GLOBAL_PLANNERS.get("astar")  # registered by now: warm() looked it up
+        if gs is not None and gs.func is _builtin_astar and gs.plugin is None:  # not a plug-in
+            return _astar_as_planned(spec, problem, params)
     deadline = (time.perf_counter() + budget.time_limit_s
                 if budget.time_limit_s is not None else None)
     gp = None
-    gname = spec.global_planner_of(params)
     if gname is not None:
         gp = run_global(gname, problem, params,
                         budget.max_iterations if ctrl_cls.search_budget else None)
@@ -149,13 +162,76 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
             msg = gp.message if ctrl_cls.search_budget else f"{what} failed: {gp.message}"
             return PlanResult(gp.status, time_s=gp.time_s, planner=spec.name,
                               expansions=gp.expansions, message=msg, info=_astar_info(gp))
-    out = ctrl_cls(problem, params, gp).run(deadline)
-    info = PlanInfo({**_astar_info(gp), **out.info} if not ctrl_cls.search_budget
-                    else out.info)
+    out = ctrl_cls.run_offline(problem, params, gp, deadline)
+    if not ctrl_cls.search_budget:
+        info = PlanInfo({**_astar_info(gp), **out.info})
+    else:
+        info = out.info if type(out.info) is PlanInfo else PlanInfo(out.info)
     info.bind(problem.grid, out.path, problem.robot_radius_m)
     length = out.length_m if out.length_m is not None else path_length(out.path)
-    return PlanResult(out.status, out.path, length, (gp.time_s if gp else 0.0) + out.time_s,
-                      spec.name, gp.expansions if gp else 0, out.steps, out.message, info)
+    return PlanResult._made(out.status, out.path, length,
+                            (gp.time_s if gp else 0.0) + out.time_s, spec.name,
+                            gp.expansions if gp else 0, out.steps, out.message, info)
+
+
+#: Whether :func:`solve` takes :func:`_astar_as_planned` where it applies (the tests turn it
+#: off to compare it with the layers it writes out).
+_LANE = True
+_AS_PLANNED: dict[type, bool] = {}
+
+
+def _as_planned(ctrl_cls: type[Controller]) -> bool:
+    """Whether ``ctrl_cls`` answers offline with the global plan as planned: the path
+    follower's own ``run_offline`` and ``run``
+    (``astar``, ``astar-replan``; a subclass may override either)."""
+    hit = _AS_PLANNED.get(ctrl_cls)
+    if hit is None:  # once per class (the follower's module is imported only when asked)
+        from pathfuse.planners.controllers.follow import FollowController
+
+        hit = _AS_PLANNED[ctrl_cls] = (
+            issubclass(ctrl_cls, FollowController) and ctrl_cls.run is FollowController.run
+            and ctrl_cls.run_offline.__func__ is  # type: ignore[attr-defined]
+            FollowController.run_offline.__func__)  # type: ignore[attr-defined]
+    return hit
+
+
+def _astar_as_planned(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
+    """:func:`solve` for a point robot without a margin whose planner follows the built-in
+    grid A*'s path as planned (:func:`_as_planned`): the result that
+    :func:`~pathfuse.planners.globals.builtin.run_global`,
+    :func:`~pathfuse.planners.globals.astar.plan_global` and the controller's
+    :meth:`~pathfuse.planners.base.Controller.run_offline` give, built in one call from the
+    map's cached searcher (issue 21: each of those layers cost 1-3 µs of a query on a
+    small map, where pyastar2d's whole query is 30-60 µs).  ``solve`` runs a plug-in
+    registered as ``astar`` through the layers.  ``tests/test_lane.py`` holds the two
+    equal."""
+    heuristic = getattr(params, "heuristic", "euclidean")
+    cut = bool(getattr(params, "corner_cutting", False))
+    if heuristic not in HEURISTICS:  # plan_global's check (the parameters have made it)
+        raise ConfigError(f"heuristic: must be one of {', '.join(map(repr, HEURISTICS))}, "
+                          f"got {_shown(heuristic)}")
+    grid = problem.grid
+    budget = problem.budget
+    limit = budget.time_limit_s
+    ox, oy = grid.origin
+    res_m = grid.resolution
+    searcher = get_searcher(grid, corner_cutting=cut)
+    t0 = time.perf_counter()
+    res = searcher.search_checked(problem.start_cell, problem.goal_cell, heuristic,
+                                  budget.max_iterations, limit, (ox, oy, res_m))
+    elapsed = time.perf_counter() - t0
+    if res.status is not Status.SUCCESS:
+        gp = searched(problem, res, elapsed, limit, heuristic, cut)
+        return PlanResult(gp.status, time_s=gp.time_s, planner=spec.name,
+                          expansions=gp.expansions, message=gp.message, info=_astar_info(gp))
+    length = res.cost * res_m
+    info = PlanInfo(cells=res.cells, cost_cells=length / res_m, heuristic=heuristic,
+                    corner_cutting=cut)
+    info._bound = (grid, res.points, float(problem.robot_radius_m))  # bind()'s body
+    # found_message's text, written out
+    return PlanResult._made(Status.SUCCESS, res.points, length, elapsed + 0.0, spec.name,
+                            res.expansions, 0, f"path through {len(res.cells)} cells, "
+                            f"{length:.6g} m, {res.expansions} expansions", info)
 
 
 def _renamed(res: PlanResult, name: str) -> PlanResult:

@@ -51,6 +51,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numba import njit
 
+from pathfuse.metrics import PlanInfo
 from pathfuse.planners.base import Controller, Observed, Outcome
 from pathfuse.planners.globals.astar import plan_global
 from pathfuse.planners.params import GlobalAStarParams, GlobalChoice, PursuitParams
@@ -103,6 +104,19 @@ def _point_at(path: np.ndarray, cum: np.ndarray, s: float) -> np.ndarray:
     return path[i] + f * (path[i + 1] - path[i])  # type: ignore[no-any-return]
 
 
+def _as_planned(gp: Any, resolution: float) -> Outcome:
+    """The offline outcome of following the global plan ``gp``: its path as planned (its
+    info a :class:`~pathfuse.metrics.PlanInfo` already, which ``solve`` keeps)."""
+    if gp.taut or not len(gp.cells):  # an any-angle path, a plug-in's waypoints
+        info = PlanInfo(global_planner=gp.planner, corners=int(len(gp.points)))
+    else:
+        info = PlanInfo(cells=gp.cells, cost_cells=gp.length_m / resolution,
+                        heuristic=gp.heuristic, corner_cutting=gp.corner_cutting)
+        if gp.planner != "astar":
+            info["global_planner"] = gp.planner
+    return Outcome(Status.SUCCESS, gp.points, 0, 0.0, gp.message, info, gp.length_m)
+
+
 def _cumlen(path: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
 
@@ -149,16 +163,16 @@ class FollowController(Controller):
         return self._rpp is not None
 
     def run(self, deadline: float | None) -> Outcome:
-        gp = self.plan
-        if gp.taut or not len(gp.cells):  # an any-angle path, a plug-in's waypoints
-            info: dict[str, Any] = {"global_planner": gp.planner,
-                                    "corners": int(len(gp.points))}
-        else:
-            info = {"cells": gp.cells, "cost_cells": gp.length_m / self.problem.grid.resolution,
-                    "heuristic": gp.heuristic, "corner_cutting": gp.corner_cutting}
-            if gp.planner != "astar":
-                info["global_planner"] = gp.planner
-        return Outcome(Status.SUCCESS, gp.points, 0, 0.0, gp.message, info, gp.length_m)
+        return _as_planned(self.plan, self.problem.grid.resolution)
+
+    @classmethod
+    def run_offline(cls, problem: Problem, params: Any, plan: Any,
+                    deadline: float | None) -> Outcome:
+        """The global path as planned, without an instance (a subclass with a :meth:`run` of
+        its own gets one)."""
+        if cls.run is not FollowController.run:
+            return super().run_offline(problem, params, plan, deadline)
+        return _as_planned(plan, problem.grid.resolution)
 
     def act(self, obs: Observed) -> np.ndarray:
         if self._rpp is not None:

@@ -49,7 +49,7 @@ from pathfuse.result import ConfigError, Status
 from pathfuse.search.astar import HEURISTICS, AStarSearcher, get_searcher
 from pathfuse.validate import short as _shown
 
-__all__ = ["GlobalPlan", "plan_global", "route", "snap_cell"]
+__all__ = ["GlobalPlan", "plan_global", "route", "snap_cell", "searched", "found_message"]
 
 _NO_POINTS = np.zeros((0, 2))
 _NO_POINTS.setflags(write=False)
@@ -173,21 +173,24 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
                           f"got {_shown(heuristic)}")
     grid = problem.grid
     r = problem.robot_radius_m
-    cs = grid.cspace(r)
-    occ = cs.occupied if occupied is None else occupied
-    if r > 0 or occupied is not None:
-        sc = snap_cell(occ, grid, problem.start, r)
-        gc = snap_cell(occ, grid, problem.goal, r)
-        if sc is None or gc is None:
-            what = "start" if sc is None else "goal"
-            status = Status.START_OCCUPIED if sc is None else Status.GOAL_OCCUPIED
+    if r == 0 and occupied is None:  # a point robot on the map itself: the problem's cells
+        cs = grid
+        occ = grid.occupied
+        sc, gc = problem.start_cell, problem.goal_cell
+    else:
+        cs = grid.cspace(r)
+        occ = cs.occupied if occupied is None else occupied
+        snapped = (snap_cell(occ, grid, problem.start, r), snap_cell(occ, grid, problem.goal, r))
+        if snapped[0] is None or snapped[1] is None:
+            what = "start" if snapped[0] is None else "goal"
+            status = Status.START_OCCUPIED if snapped[0] is None else Status.GOAL_OCCUPIED
             return GlobalPlan(status, message=f"no free cell near the {what} that the robot "
                               f"(radius {r:g} m) can reach in a straight line",
                               heuristic=heuristic, corner_cutting=corner_cutting)
-    else:
-        sc, gc = problem.start_cell, problem.goal_cell
-    budget = problem.budget
-    if problem.inflation_m > 0 and not jps:
+        sc, gc = snapped[0], snapped[1]
+    # a margin needs clearance_m > 0 or a robot (Problem.inflation_m is 0 without either)
+    if not jps and (problem.clearance_m > 0 or problem.robot is not None) \
+            and problem.inflation_m > 0:
         return _plan_with_margin(problem, occ, sc, gc, heuristic, corner_cutting,
                                  max_expansions)
     if jps:
@@ -198,13 +201,22 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
         searcher = get_searcher(cs, corner_cutting=corner_cutting)
     else:
         searcher = AStarSearcher(occ, corner_cutting=corner_cutting)
-    limit = budget.time_limit_s if time_limit_s is None else time_limit_s
+    limit = problem.budget.time_limit_s if time_limit_s is None else time_limit_s
+    ox, oy = grid.origin
+    origin = (ox, oy, grid.resolution)
     t0 = time.perf_counter()
     # the cells are in bounds and free (the problem and the snapping checked them)
-    ox, oy = grid.origin
-    res = searcher.search_checked(sc, gc, heuristic, max_expansions, limit,
-                                  (ox, oy, grid.resolution))
+    res = searcher.search_checked(sc, gc, heuristic, max_expansions, limit, origin)
     elapsed = time.perf_counter() - t0
+    return searched(problem, res, elapsed, limit, heuristic, corner_cutting)
+
+
+def searched(problem: Problem, res: Any, elapsed: float, limit: float | None, heuristic: str,
+             corner_cutting: bool) -> GlobalPlan:
+    """The :class:`GlobalPlan` of a grid search's result ``res`` (a
+    :class:`~pathfuse.search.astar.SearchResult` with world points) that took ``elapsed``
+    seconds under the time limit ``limit``: :func:`plan_global`'s outcome, its message
+    included."""
     if res.status is not Status.SUCCESS:
         if res.status is Status.NO_PATH:
             msg = ("goal is not reachable from start (different connected free regions)"
@@ -217,10 +229,15 @@ def plan_global(problem: Problem, heuristic: str = "euclidean", corner_cutting: 
                    f"({res.expansions} expansions)")
         return GlobalPlan(res.status, expansions=res.expansions, time_s=elapsed, message=msg,
                           heuristic=heuristic, corner_cutting=corner_cutting)
-    return GlobalPlan(Status.SUCCESS, res.cells, res.points, problem,
-                      res.cost * grid.resolution, res.expansions, elapsed,
-                      f"path through {len(res.cells)} cells, {res.cost * grid.resolution:.6g} m, "
-                      f"{res.expansions} expansions", heuristic, corner_cutting)
+    length = res.cost * problem.grid.resolution
+    return GlobalPlan(Status.SUCCESS, res.cells, res.points, problem, length, res.expansions,
+                      elapsed, found_message(len(res.cells), length, res.expansions),
+                      heuristic, corner_cutting)
+
+
+def found_message(cells: int, length_m: float, expansions: int) -> str:
+    """The message of a grid path found (:func:`plan_global`'s)."""
+    return f"path through {cells} cells, {length_m:.6g} m, {expansions} expansions"
 
 
 _WARM_COST: list[bool] = []

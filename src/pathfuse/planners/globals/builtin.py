@@ -84,6 +84,12 @@ def run_global(name: str, problem: Problem, params: Any = None,
     a :class:`~pathfuse.planners.registry.PluginError` naming it.
     """
     gs = get_global_planner(name)
+    if gs.func is _astar and gs.plugin is None:  # every planner's default: _astar's body
+        out = plan_global(problem, getattr(params, "heuristic", "euclidean"),
+                          bool(getattr(params, "corner_cutting", False)),
+                          max_expansions=max_expansions)
+        out.planner = name
+        return out
     kw: dict[str, Any] = {}
     accepts = gs.accepts
     if "params" in accepts:

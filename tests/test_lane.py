@@ -1,0 +1,173 @@
+"""solve()'s one-call lane for the grid A* path follower (issue 21) against the layers it
+writes out (run_global, plan_global, the controller's run_offline): the same results,
+field by field, and the lane taken exactly where it applies."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import pathfuse
+import pathfuse.planners.run as run_mod
+from pathfuse import Budget, ConfigError, GridMap, Status
+from pathfuse.planners.controllers.follow import FollowController
+from pathfuse.planners.registry import (
+    PlannerSpec,
+    get_global_planner,
+    get_planner,
+    register,
+    register_global_planner,
+)
+
+
+def _maps() -> list[GridMap]:
+    rng = np.random.default_rng(21)
+    out = []
+    for i, (h, w, p) in enumerate([(12, 17, 0.25), (20, 20, 0.35), (9, 30, 0.3)]):
+        occ = rng.random((h, w)) < p
+        if i == 2:
+            occ[:, w // 2] = True  # two regions under either corner rule
+        out.append(GridMap(occ, resolution=(1.0, 0.5, 0.25)[i], origin=((0.0, 0.0),
+                                                                        (-3.0, 1.5),
+                                                                        (2.0, -1.0))[i]))
+    return out
+
+
+def _queries(g: GridMap, n: int, seed: int) -> list[tuple[tuple[float, float], ...]]:
+    rng = np.random.default_rng(seed)
+    free = np.argwhere(~g.occupied)
+    (ox, oy), res = g.origin, g.resolution
+    out = []
+    for _ in range(n):
+        a, b = free[rng.integers(len(free))], free[rng.integers(len(free))]
+        ja, jb = rng.random(2), rng.random(2)  # anywhere inside the cells, not only centres
+        out.append(((ox + (a[1] + ja[0]) * res, oy + (a[0] + ja[1]) * res),
+                    (ox + (b[1] + jb[0]) * res, oy + (b[0] + jb[1]) * res)))
+    out.append((out[0][0], out[0][0]))  # start == goal
+    return out
+
+
+def _same(a: pathfuse.PlanResult, b: pathfuse.PlanResult) -> None:
+    assert a.status is b.status
+    assert a.planner == b.planner and a.message == b.message
+    assert a.expansions == b.expansions and a.iterations == b.iterations
+    assert a.length == b.length or (math.isnan(a.length) and math.isnan(b.length))
+    assert a.path.dtype == b.path.dtype and np.array_equal(a.path, b.path)
+    assert type(a.info) is type(b.info) and list(a.info) == list(b.info)
+    for k, v in a.info.items():
+        w = b.info[k]
+        if k.endswith("time_s") or k.endswith("_per_s"):  # clocks
+            continue
+        if isinstance(v, np.ndarray):
+            assert v.dtype == w.dtype and np.array_equal(v, w), k
+        else:
+            assert type(v) is type(w) and v == w, k
+    if a.status is Status.SUCCESS:
+        assert a.info["min_clearance_m"] == b.info["min_clearance_m"]
+
+
+def _both(monkeypatch, *args, **kw):
+    calls = []
+    lane = run_mod._astar_as_planned
+
+    def counted(*a, **k):
+        calls.append(1)
+        return lane(*a, **k)
+
+    monkeypatch.setattr(run_mod, "_astar_as_planned", counted)
+    fast = pathfuse.plan(*args, **kw)
+    monkeypatch.setattr(run_mod, "_LANE", False)
+    slow = pathfuse.plan(*args, **kw)
+    monkeypatch.setattr(run_mod, "_LANE", True)
+    _same(fast, slow)
+    return fast, len(calls)
+
+
+@pytest.mark.parametrize("planner", ["astar", "astar-replan", "astar-follow"])
+@pytest.mark.parametrize("heuristic", ["euclidean", "octile"])
+@pytest.mark.parametrize("corner_cutting", [False, True])
+def test_lane_equals_layers(monkeypatch, planner, heuristic, corner_cutting):
+    params = {"heuristic": heuristic}
+    if planner != "astar-replan":
+        params["corner_cutting"] = corner_cutting
+    elif corner_cutting:
+        pytest.skip("astar-replan has no corner rule")
+    statuses = set()
+    for i, g in enumerate(_maps()):
+        for s, t in _queries(g, 25, i):
+            r, taken = _both(monkeypatch, g, s, t, planner, **params)
+            assert taken == 1
+            statuses.add(r.status)
+            r, taken = _both(monkeypatch, g, s, t, planner, budget=Budget(max_iterations=3),
+                             **params)
+            assert taken == 1
+            statuses.add(r.status)
+    # the maps are cut into regions: every outcome of a search is compared
+    assert {Status.SUCCESS, Status.NO_PATH, Status.MAX_ITERATIONS} <= statuses
+
+
+def test_lane_timeout_and_blocked_ends(monkeypatch):
+    g = _maps()[1]
+    s, t = _queries(g, 1, 5)[0]
+    r, taken = _both(monkeypatch, g, s, t, budget=Budget(time_limit_s=1e-300))
+    assert taken == 1 and r.status in (Status.TIMEOUT, Status.SUCCESS)
+    blocked = tuple(float(v) for v in g.cell_to_world([np.argwhere(g.occupied)[0]])[0])
+    r, taken = _both(monkeypatch, g, blocked, t)
+    assert taken == 0 and r.status is Status.START_OCCUPIED
+
+
+def test_lane_not_taken_where_it_does_not_apply(monkeypatch):
+    g = GridMap.from_rows(["......", "..#...", "..#...", "......"], resolution=0.5)
+    s, t = (0.25, 0.25), (2.75, 1.75)
+    # a disc robot, a margin, another global planner, another controller: the layers
+    for kw in ({"robot_radius_m": 0.1}, {"clearance_m": 0.1}, {"global_planner": "jps"},
+               {"planner": "fusion"}, {"planner": "thetastar"}):
+        _, taken = _both(monkeypatch, g, s, t, **kw)
+        assert taken == 0, kw
+
+
+def test_lane_not_taken_for_an_own_run_or_a_plugin_astar(monkeypatch):
+    g = GridMap.from_rows(["....", ".##.", "...."])
+
+    class Mine(FollowController):
+        name = "mine-follow"
+
+        def run(self, deadline):
+            out = super().run(deadline)
+            out.message = "mine"
+            return out
+
+    base = get_planner("astar")
+    register(PlannerSpec("mine", base.params_cls, "a follower with a run of its own",
+                         controller=Mine, global_planner="astar"))
+    r, taken = _both(monkeypatch, g, (0.5, 0.5), (3.5, 2.5), "mine")
+    assert taken == 0 and r.message == "mine"
+    builtin = get_global_planner("astar")
+    register_global_planner("astar", lambda pb: np.array([pb.start, pb.goal]), "a plug-in")
+    r, taken = _both(monkeypatch, g, (0.5, 0.5), (3.5, 2.5))
+    assert taken == 0 and r.length == pytest.approx(math.hypot(3, 2))
+    register_global_planner("astar", builtin.func, builtin.description, warmup=builtin.warmup,
+                            kernels=builtin.kernels, taut=builtin.taut)
+    _, taken = _both(monkeypatch, g, (0.5, 0.5), (3.5, 2.5))
+    assert taken == 1
+
+
+def test_lane_bad_heuristic_is_the_layers_error(monkeypatch):
+    g = GridMap.from_rows(["....", ".##.", "...."])
+    spec = get_planner("astar")
+    from pathfuse.problem import Problem
+
+    pb = Problem.create(g, (0.5, 0.5), (3.5, 2.5))
+
+    class P:
+        heuristic = "manhattan"
+        corner_cutting = False
+
+    with pytest.raises(ConfigError) as fast:
+        run_mod.solve(spec, pb, P())
+    monkeypatch.setattr(run_mod, "_LANE", False)
+    with pytest.raises(ConfigError) as slow:
+        run_mod.solve(spec, pb, P())
+    assert str(fast.value) == str(slow.value)

@@ -79,6 +79,7 @@ from pathfuse.field.kernels import (
     N_S,
     S_BACKOFF,
     S_ESCAPES,
+    S_ESTEPS,
     S_K,
     S_MODE,
     S_REF,
@@ -189,6 +190,13 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
         help="ours, with walker_escape: taken off the cost of the sequence towards the "
              "heading escaped towards last tick (hysteresis; dwa's HOLD_BONUS is 0.5, with "
              "which the escape's heading swung and east_three_lanes seed 0 collided)")
+    escape_limit: bool = param(
+        True, help="ours (diff-drive robot online, velocity space): Algorithm 2's escape is "
+                   "given up after 2 x stall_steps moves that have not reached its target, "
+                   "with or without discs (the loop gives up so only among discs): the robot, "
+                   "turned by the window and taken elsewhere by the recovery, may never pass "
+                   "the escape's target, and the escape drew it back there, its progress "
+                   "along the path frozen; false = off")
     replan_new: bool = param(
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")
@@ -241,6 +249,8 @@ class FusionController(FieldController):
                                        social=p, among_discs=p.among_discs, seed=p.seed)
         self._ticks = 0
         self._seen: set[int] = set()
+        self.escapes_given_up = 0
+        """Escapes of Algorithm 2 given up online (``escape_limit``)."""
         self.replans = 0
         self._replan_every = 0
         if self._window is not None and p.replan_period_s > 0:
@@ -254,6 +264,14 @@ class FusionController(FieldController):
             return super().command(obs)
         self._replan_among_discs(obs)
         self.act(obs)  # Algorithm 2 keeps up with the robot, in a recovery too
+        if self.params.escape_limit and int(self.state[S_MODE]) != 0 \
+                and int(self.state[S_ESTEPS]) > 2 * int(self.params.stall_steps):
+            # ours (escape_limit): an escape whose target the robot does not reach is given
+            # up, as the loop gives it up among discs; Algorithm 2 resumes from the robot
+            self.state[S_MODE] = 0
+            self.state[S_REF] = self.n - 1
+            self.state[S_ESTEPS] = 0
+            self.escapes_given_up += 1
         a = self._recovering(obs, self.problem.robot, force=True)
         if a is None:
             if self._window.evader is not None:

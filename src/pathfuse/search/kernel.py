@@ -79,20 +79,10 @@ def _fetch(cell, gbuf, q, uw):
 
 
 @njit(cache=True, nogil=True)
-def _heuristic(r: int, c: int, gr: int, gc: int, octile: bool) -> float:
-    dy = abs(r - gr)
-    dx = abs(c - gc)
-    if octile:
-        if dx > dy:
-            return dx + (1.4142135623730951 - 1.0) * dy
-        return dy + (1.4142135623730951 - 1.0) * dx
-    return math.sqrt(float(dx * dx + dy * dy))
-
-
-@njit(cache=True, nogil=True)
 def _h(dy: float, dx: float, octile: bool) -> float:
-    """:func:`_heuristic` of a cell ``(dy, dx)`` from the goal, given as floats that hold
-    integers (so the squares and their sum are exact, and the value is the same)."""
+    """The heuristic of a cell ``(dy, dx)`` from the goal (octile or euclidean), given as
+    floats that hold integers (so the squares and their sum are exact: the value is that of
+    the same sums in integers)."""
     if octile:
         ax = abs(dx)
         ay = abs(dy)
@@ -232,7 +222,7 @@ def _make_kernel(use_ring: bool) -> Any:
             gbuf[us] = 0.0
             cell[us] = openv | np.uint32(8 << 1)
             sr = start // wp
-            f0 = _heuristic(sr, start - sr * wp, gr, gc, octile)
+            f0 = _h(float(sr - gr), float(start - sr * wp - gc), octile)
             k0 = _bits_of(f0)
             fh = np.int64(-1)  # typed int64, not a literal: one signature of _qpush and _spush
             used = np.int64(0)

@@ -38,21 +38,23 @@ def test_barn_help_states_the_jackal_defaults():
 def test_a_static_plan_compiles_only_what_it_runs():
     """`pathfuse plan` on a static map: the fusion loop in its signature without disc
     arrays and without a safety margin only (its moving-disc and margin code is never
-    compiled), A* with one signature, no other planner's loop, and no scipy.ndimage (the
+    compiled), A* with one signature of the euclidean heuristic's kernel (the octile one's
+    not compiled), no other planner's loop, and no scipy.ndimage (the
     paper map's regions are labelled by a flood fill)."""
     code = ("import sys, contextlib, io\n"
             "from pathfuse.cli import main\n"
             "with contextlib.redirect_stdout(io.StringIO()):\n"
             "    main(['plan', '--map', 'paper', '--planner', 'fusion'])\n"
             "from pathfuse.field import kernels as k\n"
-            "from pathfuse.search.kernel import _astar_kernel\n"
+            "from pathfuse.search.kernel import _astar_radix, _astar_ring\n"
             "print([[str(t) for t in s[-4:]] for s in k.fusion_loop.signatures])\n"
-            "print(len(_astar_kernel.signatures), len(k.field_loop.signatures))\n"
+            "print(len(_astar_ring.signatures), len(_astar_radix.signatures),\n"
+            "      len(k.field_loop.signatures))\n"
             "print('scipy.ndimage' in sys.modules)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, timeout=600)
     assert out.stdout.split("\n")[:3] == ["[['none', 'none', 'none', 'omitted(default=None)']]",
-                                        "1 0", "False"], \
+                                        "1 0 0", "False"], \
         out.stdout
 
 
@@ -101,3 +103,22 @@ def test_is_cached_tells_a_field_loop_s_static_and_online_signatures(tmp_path):
     assert [is_cached(dispatcher([static]), k) for k in (None, False, True)] == [True, True, False]
     assert [is_cached(dispatcher([online]), k) for k in (None, False, True)] == [True, False, True]
     assert is_cached(dispatcher([static, online]), True) and is_cached(dispatcher([]), None)
+
+
+def test_each_heuristic_compiles_its_own_a_star_kernel(tmp_path):
+    """The euclidean and octile heuristics run two kernels made by one factory: warming one
+    compiles it alone, and the cold-cache notice tells them apart although they share
+    numba's index file."""
+    import os
+
+    code = ("from pathfuse.search.astar import warmup\n"
+            "from pathfuse.search.kernel import _astar_radix, _astar_ring\n"
+            "from pathfuse.planners.kernel_cache import is_cached\n"
+            "print(is_cached(_astar_ring), is_cached(_astar_radix))\n"
+            "warmup(('euclidean',))\n"
+            "print(len(_astar_ring.signatures), len(_astar_radix.signatures))\n"
+            "print(is_cached(_astar_ring), is_cached(_astar_radix))\n")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=600, env=env)
+    assert out.stdout.split("\n")[:3] == ["False False", "1 0", "True False"], out.stdout

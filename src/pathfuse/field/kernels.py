@@ -191,7 +191,11 @@ def _step(x, y, fx, fy, s, cm, margin):
     return nx, ny, -1
 
 
-@njit(cache=True, inline="always")
+# _grow, _grow_int and _escape_move are called (not inlined by numba, inline="always"):
+# they run when a buffer is full or the robot escapes, and inlining them cost the loops'
+# first compilation about 0.5 s of CPU (numba re-reads and re-types an inlined body at
+# each call site); LLVM may still inline them
+@njit(cache=True)
 def _grow(buf, n):
     if n + 2 <= buf.shape[0]:
         return buf
@@ -202,7 +206,7 @@ def _grow(buf, n):
     return nb
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _grow_int(kbuf, n):
     if n + 2 <= kbuf.shape[0]:
         return kbuf
@@ -297,7 +301,7 @@ def field_loop(buf, n, max_steps, cm, subs, state, s, ds, dpos, dvel, drad, marg
 
 
 # --------------------------------------------------------------------- fusion loop
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _escape_move(x, y, tx, ty, s, cm, ds, dpos, dvel, drad):
     """One escape move towards ``(tx, ty)``: ``(nx, ny, moved, reached)``.
 

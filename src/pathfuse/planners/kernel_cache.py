@@ -7,6 +7,7 @@ never wrong by being noisy.
 
 from __future__ import annotations
 
+import hashlib
 import os
 from typing import Any
 
@@ -14,7 +15,8 @@ __all__ = ["cold_kernels", "is_cached"]
 
 
 def is_cached(dispatcher: Any, online: bool | None = None) -> bool:
-    """True when ``dispatcher`` (an ``@njit(cache=True)`` function) has an index on disk.
+    """True when ``dispatcher`` (an ``@njit(cache=True)`` function) has an index on disk
+    (and, for a kernel made by a factory, an entry of its own in it).
 
     The field loops (:mod:`pathfuse.field.kernels`) have two kinds of signature, a
     static plan's (``None`` for the discs) and an online one's: with ``online`` given,
@@ -27,12 +29,21 @@ def is_cached(dispatcher: Any, online: bool | None = None) -> bool:
         return True
     if not os.path.exists(index):
         return False
-    if online is None:
+    closure = getattr(getattr(dispatcher, "py_func", None), "__closure__", None)
+    if online is None and closure is None:
         return True
     try:
         from numba import types
 
         keys = list(cache_file._load_index())
+        if closure is not None:  # kernels made by one factory share an index: numba's key
+            # tells them apart by a hash of the closure's variables
+            from numba.core.serialize import dumps
+
+            cvars = hashlib.sha256(dumps(tuple(c.cell_contents for c in closure)))
+            keys = [key for key in keys if key[2][1] == cvars.hexdigest()]
+        if online is None:
+            return bool(keys)
         return any(online != any(isinstance(t, types.NoneType) for t in key[0])
                    for key in keys)
     except Exception:  # noqa: BLE001 - numba's internals differ: count it as cached

@@ -24,7 +24,7 @@ from pathfuse.planners.base import Controller, Observed
 from pathfuse.planners.globals.astar import GlobalPlan, searched
 from pathfuse.planners.globals.builtin import _astar as _builtin_astar
 from pathfuse.planners.globals.builtin import run_global
-from pathfuse.planners.registry import GLOBAL_PLANNERS, PlannerSpec
+from pathfuse.planners.registry import GLOBAL_PLANNERS, PlannerSpec, make_params
 from pathfuse.problem import Problem
 from pathfuse.result import ConfigError, PlanResult, Status, path_length
 from pathfuse.search.astar import HEURISTICS, get_searcher
@@ -32,7 +32,7 @@ from pathfuse.validate import short as _shown
 
 __all__ = ["solve", "start_online", "warm", "warm_query", "Stopped", "PlanInfo"]
 
-_WARM: set[tuple[str, str | None, bool, bool, bool]] = set()
+_WARM: set[tuple[str, str | None, bool, bool, bool, str | None]] = set()
 _WARM_SEGMENT: list[bool] = []
 
 
@@ -41,20 +41,21 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
          margin: bool = False) -> None:
     """Compile (or load from numba's cache) the kernels ``spec`` runs, once per process.
 
-    Only what runs is compiled: the global planner that ``params`` name (the
-    preset's by default), the controller's kernels for a plan on a static map
-    (with ``margin``: with a safety margin, ``clearance_m`` > 0) or, with
-    ``online``, those it runs online (among moving discs: the field loops'
-    signature with disc arrays), and with ``diff_drive`` (which implies
-    ``online``) those it runs online on a diff-drive robot only.  ``segments`` adds the
-    exact segment check the waypoints and the robot disc's end-point check
-    use (a point robot's ``astar`` plan needs neither).  ``notify`` is called
-    first when the kernels are not in numba's on-disk cache yet (the command
-    line prints a one-line notice with it).
+    Only what runs is compiled: the global planner that ``params`` name (the preset's by
+    default; for A*, the kernel of the ``heuristic`` they name), the controller's kernels
+    for a plan on a static map (with ``margin``: with a safety margin, ``clearance_m`` > 0)
+    or, with ``online``, those it runs online (among moving discs: the field loops'
+    signature with disc arrays), and with ``diff_drive`` (which implies ``online``) those it
+    runs online on a diff-drive robot only. ``segments`` adds the exact segment check the
+    waypoints and the robot disc's end-point check use (a point robot's ``astar`` plan needs
+    neither). ``notify`` is called first when the kernels are not in numba's on-disk cache
+    yet (the command line prints a one-line notice with it).
     """
     gname = spec.global_planner_of(params)
     online = online or diff_drive
-    key = (spec.name, gname, diff_drive, online, margin)
+    # the A* heuristic picks one of two kernels: only the one the plan runs is compiled
+    heuristic = getattr(params if params is not None else make_params(spec), "heuristic", None)
+    key = (spec.name, gname, diff_drive, online, margin, heuristic)
     if key in _WARM:
         if segments and not _WARM_SEGMENT:
             _warm_segments()
@@ -69,7 +70,7 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
     if gname is not None:
         from pathfuse.planners.globals.builtin import warm_global
 
-        warm_global(gname)
+        warm_global(gname, heuristic)
     if spec.controller is not None:
         if online:
             spec.controller.warmup_online()
@@ -133,7 +134,8 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     # _needs_segments, written out
     segments = problem.robot_radius_m > 0 or ctrl_cls is None or not ctrl_cls.search_budget
     margin = problem.clearance_m > 0
-    if (spec.name, gname, False, False, margin) not in _WARM or \
+    if (spec.name, gname, False, False, margin, getattr(params, "heuristic", None)) \
+            not in _WARM or \
             (segments and not _WARM_SEGMENT):  # warm()'s own test, without its call
         warm(spec, params=params, segments=segments, margin=margin)
     budget = problem.budget

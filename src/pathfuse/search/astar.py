@@ -94,7 +94,8 @@ from pathfuse.search.kernel import (
     _CHUNK,
     _RING_SIZE,
     _STAMP_LIMIT,
-    _astar_kernel,
+    _astar_radix,
+    _astar_ring,
     _trace,
 )
 from pathfuse.validate import short as _shown
@@ -208,7 +209,7 @@ class AStarSearcher(_Regions):
         self._wp = w + 2
         cell = np.full((h + 2, w + 2), _BLOCKED, dtype=np.uint32)
         np.multiply(occ, _BLOCKED, out=cell[1:-1, 1:-1], dtype=np.uint32)  # 3x a mask
-        self._cell = cell.ravel()  # blocked / stamp and move: see kernel._astar_kernel
+        self._cell = cell.ravel()  # blocked / stamp and move: see kernel._make_kernel
         n = self._cell.size
         self._g = np.empty(n, dtype=np.float64)
         cap = int(min(max(1024, n // 4), 1 << 20))
@@ -220,6 +221,8 @@ class AStarSearcher(_Regions):
         self._heads = np.empty(_RING_SIZE, dtype=np.int32)
         self._bits = np.empty(_RING_SIZE // 64, dtype=np.uint64)
         self._meta = np.zeros(5, dtype=np.int64)
+        self._cq = np.empty(8, dtype=np.uint64)  # the kernel's scratch: one expansion's
+        self._cf = np.empty(8)  # queued neighbours and their f
         self._gen = 0
         self._closed_gen = -1  # stamp of the cells the last search closed (-1: none)
         self.free_count = int(occ.size - np.count_nonzero(occ))
@@ -310,16 +313,16 @@ class AStarSearcher(_Regions):
         self._gen += 2
         gen = self._gen
         self._closed_gen = gen + 1
-        octile = heuristic == "octile"
+        kernel = _KERNEL_ENTRY["octile" if heuristic == "octile" else "euclidean"]
         chunk = _CHUNK if time_limit_s is not None else budget
         done = 0
         first = start
         while True:
             step = min(chunk, budget - done)
-            code, n = _kernel_entry(
+            code, n = kernel(
                 self._cell, self._g, self._qkey, self._qnode, self._qnext, self._heads,
-                self._bits, self._skey, self._snode, self._meta, gen, first, goal, wp,
-                octile, self.corner_cutting, not octile, step,
+                self._bits, self._skey, self._snode, self._meta, self._cq, self._cf, gen,
+                first, goal, wp, self.corner_cutting, step,
             )
             first = -1
             done += n
@@ -442,9 +445,9 @@ def _new_searcher(grid, corner_cutting: bool,  # type: ignore[no-untyped-def]
     return s
 
 
-# What a search calls: the kernel and the trace, or after warmup() numba's compiled entry
-# of each for the searcher's argument types (see _entry_point).
-_kernel_entry: Any = _astar_kernel
+# What a search calls for each heuristic: its kernel, or after warmup() numba's compiled
+# entry of it for the searcher's argument types (see _entry_point); the same for the trace.
+_KERNEL_ENTRY: dict[str, Any] = {"euclidean": _astar_ring, "octile": _astar_radix}
 _trace_entry: Any = _trace
 
 
@@ -464,24 +467,27 @@ def _entry_point(dispatcher: Any, args: tuple[Any, ...]) -> Any:
         return dispatcher
 
 
-_WARM = False
+_WARM: set[str] = set()  # the heuristics whose kernel is compiled or loaded
 
 
-def warmup() -> None:
-    """Compile (or load from numba's on-disk cache) the A* kernels on a tiny grid."""
-    global _WARM, _kernel_entry, _trace_entry
-    if _WARM:
+def warmup(heuristics: tuple[str, ...] = HEURISTICS) -> None:
+    """Compile (or load from numba's on-disk cache) the A* kernels of ``heuristics`` (each
+    has its own) on a tiny grid."""
+    global _trace_entry
+    todo = [h for h in heuristics if h not in _WARM]
+    if not todo:
         return
     occ = np.zeros((3, 4), dtype=bool)
     occ[1, 1] = True
     for cut in (False, True):
         s = AStarSearcher(occ, corner_cutting=cut)
-        for heur in HEURISTICS:
+        for heur in todo:
             s.search((0, 0), (2, 3), heuristic=heur)
             s.search((0, 0), (2, 3), heuristic=heur, time_limit_s=10.0)
     # the arguments of a search (the types are all that matters; nothing is called)
-    _kernel_entry = _entry_point(_astar_kernel, (
-        s._cell, s._g, s._qkey, s._qnode, s._qnext, s._heads, s._bits, s._skey, s._snode,
-        s._meta, 2, 5, 7, s._wp, False, False, True, 1))
+    for heur in todo:
+        _KERNEL_ENTRY[heur] = _entry_point(_KERNEL_ENTRY[heur], (
+            s._cell, s._g, s._qkey, s._qnode, s._qnext, s._heads, s._bits, s._skey,
+            s._snode, s._meta, s._cq, s._cf, 2, 5, 7, s._wp, False, 1))
     _trace_entry = _entry_point(_trace, (s._cell, 5, 7, s._wp, 0.0, 0.0, 1.0))
-    _WARM = True
+    _WARM.update(todo)

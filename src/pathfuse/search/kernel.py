@@ -5,6 +5,7 @@ owns the buffers and calls it."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from llvmlite import ir
@@ -78,20 +79,10 @@ def _fetch(cell, gbuf, q, uw):
 
 
 @njit(cache=True, nogil=True)
-def _heuristic(r: int, c: int, gr: int, gc: int, octile: bool) -> float:
-    dy = abs(r - gr)
-    dx = abs(c - gc)
-    if octile:
-        if dx > dy:
-            return dx + (1.4142135623730951 - 1.0) * dy
-        return dy + (1.4142135623730951 - 1.0) * dx
-    return math.sqrt(float(dx * dx + dy * dy))
-
-
-@njit(cache=True, nogil=True)
 def _h(dy: float, dx: float, octile: bool) -> float:
-    """:func:`_heuristic` of a cell ``(dy, dx)`` from the goal, given as floats that hold
-    integers (so the squares and their sum are exact, and the value is the same)."""
+    """The heuristic of a cell ``(dy, dx)`` from the goal (octile or euclidean), given as
+    floats that hold integers (so the squares and their sum are exact: the value is that of
+    the same sums in integers)."""
     if octile:
         ax = abs(dx)
         ay = abs(dy)
@@ -156,311 +147,326 @@ def _spush(skey, snode, size, key, node):
 # registers, a relaxation helper that takes the arrays to a call per move (each array's
 # fields on the stack) and, inlined by numba (inline="always"), to reference counting per
 # array and move; the helper versions ran 3-6x slower than the loop (issue 21).
-@njit(cache=True, nogil=True)
-def _astar_kernel(
-    cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, gen,
-    start, goal, wp, octile, corner_cutting, use_ring, max_exp,
-):
-    """Run A* until the goal is closed, the open list empties or ``max_exp`` expansions.
+def _make_kernel(use_ring: bool) -> Any:
+    """The A* kernel of one open list: ``use_ring`` (the euclidean heuristic) or the radix
+    heap (octile).  ``use_ring`` and ``octile`` are constants of the closure, so numba
+    prunes the other open list's code before typing it: each kernel compiles about half the
+    code, and a query compiles only the one its heuristic runs (numba's cache keeps both
+    apart: its index key hashes a closure's variables)."""
+    octile = not use_ring
 
-    One ``uint32`` word per padded cell (``cell``) holds what a relaxation
-    reads: ``_BLOCKED`` (all bits set) on a blocked or border cell, else
-    ``stamp << 5 | move << 1`` with ``move`` (0-8) the move that reached it.
-    ``stamp == gen``: ``gbuf[p]`` is valid and ``p`` open; ``stamp == gen +
-    1``: ``p`` closed.  So one compare (``word >= (gen + 1) << 5``) rejects a
-    closed or blocked neighbour, bit 0 tells blocked from free for the corner
-    rule, and a cell's state costs one load from one array (the search is
-    bound by memory on large maps: separate free, stamp and parent arrays cost
-    2-4x more in the grid work).  Indices are unsigned (no negative-index
-    wraparound test on each access).  ``start >= 0`` starts a query;
-    ``start < 0`` resumes the one whose open list is saved in the arrays and
-    ``meta``.
+    @njit(cache=True, nogil=True)
+    def kernel(
+        cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, cq, cf, gen,
+        start, goal, wp, corner_cutting, max_exp,
+    ):
+        """Run A* until the goal is closed, the open list empties or ``max_exp`` expansions.
 
-    Two open lists, both exact and both keyed by the IEEE-754 bits of ``f``
-    (non-negative doubles order like their bits); entries live in a pool
-    (``qkey``, ``qnode``, ``qnext``) of singly linked lists with a free list:
+        One ``uint32`` word per padded cell (``cell``) holds what a relaxation
+        reads: ``_BLOCKED`` (all bits set) on a blocked or border cell, else
+        ``stamp << 5 | move << 1`` with ``move`` (0-8) the move that reached it.
+        ``stamp == gen``: ``gbuf[p]`` is valid and ``p`` open; ``stamp == gen +
+        1``: ``p`` closed.  So one compare (``word >= (gen + 1) << 5``) rejects a
+        closed or blocked neighbour, bit 0 tells blocked from free for the corner
+        rule, and a cell's state costs one load from one array (the search is
+        bound by memory on large maps: separate free, stamp and parent arrays cost
+        2-4x more in the grid work).  Indices are unsigned (no negative-index
+        wraparound test on each access).  ``start >= 0`` starts a query;
+        ``start < 0`` resumes the one whose open list is saved in the arrays and
+        ``meta``.
 
-    * ``use_ring=False``: a radix heap (Ahuja et al. 1990).  Bucket ``b`` of
-      ``heads[:65]`` holds keys whose highest bit differing from the last
-      popped key is ``b - 1`` (bucket 0: equal keys, popped last-in first-out).
-      When bucket 0 is empty the first non-empty bucket is searched for its
-      minimum, which becomes the new last key, and spread over lower buckets.
-      Best when many ``f`` are exactly equal (the octile heuristic).
-    * ``use_ring=True``: ``f`` is cut into buckets of ``1 / _RING_SCALE``
-      cells.  With a consistent heuristic every open ``f`` lies in
-      ``[f_min, f_min + 2 sqrt 2]`` (a child's ``f`` exceeds its parent's by at
-      most two steps), so ``_RING_SIZE`` buckets used cyclically hold them
-      all; a bitmap (``bits``) finds the next non-empty one.  The bucket being
-      expanded is moved into a binary heap (``skey``, ``snode``) ordered
-      exactly by ``f``; children falling into it go straight there.  Each entry
-      moves once: best when ``f`` values are mostly distinct (euclidean).  A
-      bucket of one entry, the usual case, is popped without the heap.  The
-      heap is a binary min-heap: a parent not greater than the key stops a
-      push (:func:`_spush`), a child not less than the moved key stops a pop
-      (written out in the loop).
+        Two open lists, both exact and both keyed by the IEEE-754 bits of ``f``
+        (non-negative doubles order like their bits); entries live in a pool
+        (``qkey``, ``qnode``, ``qnext``) of singly linked lists with a free list:
 
-    ``meta`` = [radix: last key / ring: current bucket, free-list head, pool
-    slots used, pool entries, heap entries].  Returns (code, expansions in
-    this call).
-    """
-    s2 = 1.4142135623730951
-    one = np.uint64(1)
-    rmask = _RING_SIZE - 1
-    gr = goal // wp
-    gc = goal - gr * wp
-    uw = np.uint64(wp)
-    ugoal = np.uint64(goal)
-    openv = np.uint32(gen << 5)
-    closedv = np.uint32((gen + 1) << 5)
-    bit0 = np.uint32(1)
-    low = np.uint32(31)
-    invw = 1.0 / wp
-    cq = np.empty(8, dtype=np.uint64)  # the neighbours one expansion queues, and their f
-    cf = np.empty(8)
-    if start >= 0:
-        us = np.uint64(start)
-        gbuf[us] = 0.0
-        cell[us] = openv | np.uint32(8 << 1)
-        sr = start // wp
-        f0 = _heuristic(sr, start - sr * wp, gr, gc, octile)
-        k0 = _bits_of(f0)
-        fh = np.int64(-1)  # typed int64, not a literal: one signature of _qpush and _spush
-        used = np.int64(0)
-        if use_ring:
-            for i in range(_RING_SIZE):
-                heads[i] = -1
-            for i in range(_RING_SIZE // 64):
-                bits[i] = 0
-            last = np.uint64(0)
-            cur = np.int64(f0 * _RING_SCALE)
-            size = 0
-            ssize = _spush(skey, snode, np.int64(0), k0, start)
+        * radix kernel (``use_ring`` false, octile): a radix heap (Ahuja et al.
+          1990).  Bucket ``b`` of ``heads[:65]`` holds keys whose highest bit
+          differing from the last popped key is ``b - 1`` (bucket 0: equal keys,
+          popped last-in first-out).
+          When bucket 0 is empty the first non-empty bucket is searched for its
+          minimum, which becomes the new last key, and spread over lower buckets.
+          Best when many ``f`` are exactly equal (the octile heuristic).
+        * ring kernel (``use_ring``, euclidean): ``f`` is cut into buckets of ``1 / _RING_SCALE``
+          cells.  With a consistent heuristic every open ``f`` lies in
+          ``[f_min, f_min + 2 sqrt 2]`` (a child's ``f`` exceeds its parent's by at
+          most two steps), so ``_RING_SIZE`` buckets used cyclically hold them
+          all; a bitmap (``bits``) finds the next non-empty one.  The bucket being
+          expanded is moved into a binary heap (``skey``, ``snode``) ordered
+          exactly by ``f``; children falling into it go straight there.  Each entry
+          moves once: best when ``f`` values are mostly distinct (euclidean).  A
+          bucket of one entry, the usual case, is popped without the heap.  The
+          heap is a binary min-heap: a parent not greater than the key stops a
+          push (:func:`_spush`), a child not less than the moved key stops a pop
+          (written out in the loop).
+
+        ``meta`` = [radix: last key / ring: current bucket, free-list head, pool
+        slots used, pool entries, heap entries].  ``cq`` (uint64) and ``cf``
+        (float64), 8 entries each, hold the neighbours one expansion queues and
+        their ``f`` (the caller's, so that the kernel allocates nothing).  Returns
+        (code, expansions in this call).
+        """
+        s2 = 1.4142135623730951
+        one = np.uint64(1)
+        rmask = _RING_SIZE - 1
+        gr = goal // wp
+        gc = goal - gr * wp
+        uw = np.uint64(wp)
+        ugoal = np.uint64(goal)
+        openv = np.uint32(gen << 5)
+        closedv = np.uint32((gen + 1) << 5)
+        bit0 = np.uint32(1)
+        low = np.uint32(31)
+        invw = 1.0 / wp
+        if start >= 0:
+            us = np.uint64(start)
+            gbuf[us] = 0.0
+            cell[us] = openv | np.uint32(8 << 1)
+            sr = start // wp
+            f0 = _h(float(sr - gr), float(start - sr * wp - gc), octile)
+            k0 = _bits_of(f0)
+            fh = np.int64(-1)  # typed int64, not a literal: one signature of _qpush and _spush
+            used = np.int64(0)
+            if use_ring:
+                for i in range(_RING_SIZE):
+                    heads[i] = -1
+                for i in range(_RING_SIZE // 64):
+                    bits[i] = 0
+                last = np.uint64(0)
+                cur = np.int64(f0 * _RING_SCALE)
+                size = 0
+                ssize = _spush(skey, snode, np.int64(0), k0, start)
+            else:
+                for i in range(65):
+                    heads[i] = -1
+                last = k0
+                cur = np.int64(0)
+                fh, used = _qpush(qkey, qnode, qnext, heads, last, fh, used, last, start)
+                size = 1
+                ssize = 0
         else:
-            for i in range(65):
-                heads[i] = -1
-            last = k0
-            cur = np.int64(0)
-            fh, used = _qpush(qkey, qnode, qnext, heads, last, fh, used, last, start)
-            size = 1
-            ssize = 0
-    else:
-        last = np.uint64(meta[0])
-        cur = meta[0]
-        fh = meta[1]
-        used = meta[2]
-        size = meta[3]
-        ssize = meta[4]
-    cap = qkey.shape[0]
-    scap = skey.shape[0]
-    n_exp = 0
-    code = CODE_NO_PATH
-    while size > 0 or ssize > 0:
-        if n_exp >= max_exp:
-            code = CODE_RUNNING
-            break
-        if used + 8 > cap or size + ssize + 8 > scap:
-            code = CODE_GROW
-            break
-        # ---- pop the entry with the smallest f
-        if use_ring:
-            pi = -1  # set below when a bucket of one entry gives the node directly
-            if ssize == 0:
-                pos = (cur + 1) & rmask
-                w = pos >> 6
-                word = bits[w] & (~np.uint64(0) << np.uint64(pos & 63))
-                while word == 0:
-                    w = (w + 1) & (_RING_SIZE // 64 - 1)
-                    word = bits[w]
-                b = (w << 6) + _trailing_zeros(word)
-                cur += (b - cur) & rmask
-                bits[b >> 6] &= ~(one << np.uint64(b & 63))
-                rest = word & (word - one)  # the next bucket in this word: prefetch ahead
-                if rest != 0:
-                    _fetch(cell, gbuf, np.uint64(qnode[heads[(w << 6) + _trailing_zeros(rest)]]),
-                           uw)
-                e = heads[b]
-                heads[b] = -1
-                if qnext[e] < 0:  # one entry (the usual case): the heap would pop it
-                    pi = qnode[e]
-                    _fetch(cell, gbuf, np.uint64(pi), uw)
-                    size -= 1
-                    qnext[e] = fh
-                    fh = e
-                else:
-                    while e >= 0:
-                        nxt = qnext[e]
-                        _fetch(cell, gbuf, np.uint64(qnode[e]), uw)
-                        ssize = _spush(skey, snode, ssize, qkey[e], np.int64(qnode[e]))
+            last = np.uint64(meta[0])
+            cur = meta[0]
+            fh = meta[1]
+            used = meta[2]
+            size = meta[3]
+            ssize = meta[4]
+        cap = qkey.shape[0]
+        scap = skey.shape[0]
+        n_exp = 0
+        code = CODE_NO_PATH
+        while size > 0 or ssize > 0:
+            if n_exp >= max_exp:
+                code = CODE_RUNNING
+                break
+            if used + 8 > cap or size + ssize + 8 > scap:
+                code = CODE_GROW
+                break
+            # ---- pop the entry with the smallest f
+            if use_ring:
+                pi = -1  # set below when a bucket of one entry gives the node directly
+                if ssize == 0:
+                    pos = (cur + 1) & rmask
+                    w = pos >> 6
+                    word = bits[w] & (~np.uint64(0) << np.uint64(pos & 63))
+                    while word == 0:
+                        w = (w + 1) & (_RING_SIZE // 64 - 1)
+                        word = bits[w]
+                    b = (w << 6) + _trailing_zeros(word)
+                    cur += (b - cur) & rmask
+                    bits[b >> 6] &= ~(one << np.uint64(b & 63))
+                    rest = word & (word - one)  # the next bucket in this word: prefetch ahead
+                    if rest != 0:
+                        nb = heads[(w << 6) + _trailing_zeros(rest)]
+                        _fetch(cell, gbuf, np.uint64(qnode[nb]), uw)
+                    e = heads[b]
+                    heads[b] = -1
+                    if qnext[e] < 0:  # one entry (the usual case): the heap would pop it
+                        pi = qnode[e]
+                        _fetch(cell, gbuf, np.uint64(pi), uw)
                         size -= 1
                         qnext[e] = fh
                         fh = e
-                        e = nxt
-            if pi < 0:  # pop the small heap's root, written out here (as a helper it
-                # was a call that LLVM did not inline, the arrays' fields pushed on the
-                # stack for each of about one pop per expansion on the Boston maps)
-                pi = snode[0]
-                ssize -= 1
-                if ssize > 0:
-                    key = skey[ssize]
-                    node = snode[ssize]
-                    i = 0
-                    while True:
-                        child = 2 * i + 1
-                        if child >= ssize:
-                            break
-                        ck = skey[child]
-                        if child + 1 < ssize and skey[child + 1] < ck:
-                            child += 1
+                    else:
+                        while e >= 0:
+                            nxt = qnext[e]
+                            _fetch(cell, gbuf, np.uint64(qnode[e]), uw)
+                            ssize = _spush(skey, snode, ssize, qkey[e], np.int64(qnode[e]))
+                            size -= 1
+                            qnext[e] = fh
+                            fh = e
+                            e = nxt
+                if pi < 0:  # pop the small heap's root, written out here (as a helper it
+                    # was a call that LLVM did not inline, the arrays' fields pushed on the
+                    # stack for each of about one pop per expansion on the Boston maps)
+                    pi = snode[0]
+                    ssize -= 1
+                    if ssize > 0:
+                        key = skey[ssize]
+                        node = snode[ssize]
+                        i = 0
+                        while True:
+                            child = 2 * i + 1
+                            if child >= ssize:
+                                break
                             ck = skey[child]
-                        if ck < key:
-                            skey[i] = ck
-                            snode[i] = snode[child]
-                            i = child
-                        else:
-                            break
-                    skey[i] = key
-                    snode[i] = node
-        else:
-            if heads[0] < 0:
-                i = 1
-                while heads[i] < 0:
-                    i += 1
-                e = heads[i]
-                m = qkey[e]
-                e = qnext[e]
-                while e >= 0:
-                    if qkey[e] < m:
-                        m = qkey[e]
-                    e = qnext[e]
-                last = m
-                e = heads[i]
-                heads[i] = -1
-                while e >= 0:
-                    nxt = qnext[e]
-                    k = qkey[e]
-                    if k == last:
-                        b = 0
-                        _fetch(cell, gbuf, np.uint64(qnode[e]), uw)
-                    else:
-                        b = _bit_length(k ^ last)
-                    qnext[e] = heads[b]
-                    heads[b] = e
-                    e = nxt
-            e = heads[0]
-            heads[0] = qnext[e]
-            pi = qnode[e]
-            if heads[0] >= 0:
-                _fetch(cell, gbuf, np.uint64(qnode[heads[0]]), uw)
-            qnext[e] = fh
-            fh = e
-            size -= 1
-        p = np.uint64(pi)
-        sp = cell[p]
-        if sp >= closedv:
-            continue  # stale duplicate of a node already expanded
-        cell[p] = closedv | (sp & low)
-        n_exp += 1
-        if p == ugoal:
-            code = CODE_SUCCESS
-            break
-        # ---- relax the 8 moves k = 0..7 (the word's move bits k << 1; row, col steps
-        # (0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1), as in
-        # _trace), written out: the queue order, which decides ties, is k's
-        g0 = gbuf[p]
-        ur = np.uint64(np.int64(pi) * invw)  # p // wp, off by at most one: corrected
-        if ur * uw > p:
-            ur -= one
-        elif ur * uw + uw <= p:
-            ur += one
-        dy = float(np.int64(ur) - gr)  # integers in floats: the heuristic's sums are exact
-        dx = float(np.int64(p - ur * uw) - gc)
-        se = cell[p + one]
-        sw = cell[p - one]
-        sn = cell[p + uw]
-        ss = cell[p - uw]
-        n = 0  # improved neighbours, queued below in this order
-        if se < closedv:
-            ng = g0 + 1.0
-            if se < openv or ng < gbuf[p + one]:
-                cq[n], cf[n], n = p + one, ng + _h(dy, dx + 1.0, octile), n + 1
-                gbuf[p + one], cell[p + one] = ng, openv
-        if sw < closedv:
-            ng = g0 + 1.0
-            if sw < openv or ng < gbuf[p - one]:
-                cq[n], cf[n], n = p - one, ng + _h(dy, dx - 1.0, octile), n + 1
-                gbuf[p - one], cell[p - one] = ng, openv | np.uint32(1 << 1)
-        if sn < closedv:
-            ng = g0 + 1.0
-            if sn < openv or ng < gbuf[p + uw]:
-                cq[n], cf[n], n = p + uw, ng + _h(dy + 1.0, dx, octile), n + 1
-                gbuf[p + uw], cell[p + uw] = ng, openv | np.uint32(2 << 1)
-        if ss < closedv:
-            ng = g0 + 1.0
-            if ss < openv or ng < gbuf[p - uw]:
-                cq[n], cf[n], n = p - uw, ng + _h(dy - 1.0, dx, octile), n + 1
-                gbuf[p - uw], cell[p - uw] = ng, openv | np.uint32(3 << 1)
-        # a diagonal move needs both orthogonal cells it passes free (bit 0 clear: the
-        # words read above; a relaxation never changes bit 0) unless corners may be cut
-        fe = (se & bit0) == 0
-        fw = (sw & bit0) == 0
-        fn = (sn & bit0) == 0
-        fs = (ss & bit0) == 0
-        ng = g0 + s2
-        if corner_cutting or (fn and fe):
-            q = p + uw + one
-            st = cell[q]
-            if st < closedv and (st < openv or ng < gbuf[q]):
-                cq[n], cf[n], n = q, ng + _h(dy + 1.0, dx + 1.0, octile), n + 1
-                gbuf[q], cell[q] = ng, openv | np.uint32(4 << 1)
-        if corner_cutting or (fn and fw):
-            q = p + uw - one
-            st = cell[q]
-            if st < closedv and (st < openv or ng < gbuf[q]):
-                cq[n], cf[n], n = q, ng + _h(dy + 1.0, dx - 1.0, octile), n + 1
-                gbuf[q], cell[q] = ng, openv | np.uint32(5 << 1)
-        if corner_cutting or (fs and fe):
-            q = p - uw + one
-            st = cell[q]
-            if st < closedv and (st < openv or ng < gbuf[q]):
-                cq[n], cf[n], n = q, ng + _h(dy - 1.0, dx + 1.0, octile), n + 1
-                gbuf[q], cell[q] = ng, openv | np.uint32(6 << 1)
-        if corner_cutting or (fs and fw):
-            q = p - uw - one
-            st = cell[q]
-            if st < closedv and (st < openv or ng < gbuf[q]):
-                cq[n], cf[n], n = q, ng + _h(dy - 1.0, dx - 1.0, octile), n + 1
-                gbuf[q], cell[q] = ng, openv | np.uint32(7 << 1)
-        for j in range(n):
-            f = cf[j]
-            kf = _bits_of(f)
-            qi = np.int64(cq[j])
-            if use_ring:
-                kq = np.int64(f * _RING_SCALE)
-                if kq <= cur:  # the bucket being expanded (or below it, by rounding)
-                    ssize = _spush(skey, snode, ssize, kf, qi)
-                else:
-                    if fh >= 0:
-                        e = fh
-                        fh = qnext[e]
-                    else:
-                        e = used
-                        used += 1
-                    qkey[e] = kf
-                    qnode[e] = qi
-                    b = kq & rmask
-                    qnext[e] = heads[b]
-                    heads[b] = e
-                    bits[b >> 6] |= one << np.uint64(b & 63)
-                    size += 1
+                            if child + 1 < ssize and skey[child + 1] < ck:
+                                child += 1
+                                ck = skey[child]
+                            if ck < key:
+                                skey[i] = ck
+                                snode[i] = snode[child]
+                                i = child
+                            else:
+                                break
+                        skey[i] = key
+                        snode[i] = node
             else:
-                fh, used = _qpush(qkey, qnode, qnext, heads, last, fh, used, kf, qi)
-                size += 1
-    meta[0] = cur if use_ring else np.int64(last)
-    meta[1] = fh
-    meta[2] = used
-    meta[3] = size
-    meta[4] = ssize
-    return code, n_exp
+                if heads[0] < 0:
+                    i = 1
+                    while heads[i] < 0:
+                        i += 1
+                    e = heads[i]
+                    m = qkey[e]
+                    e = qnext[e]
+                    while e >= 0:
+                        if qkey[e] < m:
+                            m = qkey[e]
+                        e = qnext[e]
+                    last = m
+                    e = heads[i]
+                    heads[i] = -1
+                    while e >= 0:
+                        nxt = qnext[e]
+                        k = qkey[e]
+                        if k == last:
+                            b = 0
+                            _fetch(cell, gbuf, np.uint64(qnode[e]), uw)
+                        else:
+                            b = _bit_length(k ^ last)
+                        qnext[e] = heads[b]
+                        heads[b] = e
+                        e = nxt
+                e = heads[0]
+                heads[0] = qnext[e]
+                pi = qnode[e]
+                if heads[0] >= 0:
+                    _fetch(cell, gbuf, np.uint64(qnode[heads[0]]), uw)
+                qnext[e] = fh
+                fh = e
+                size -= 1
+            p = np.uint64(pi)
+            sp = cell[p]
+            if sp >= closedv:
+                continue  # stale duplicate of a node already expanded
+            cell[p] = closedv | (sp & low)
+            n_exp += 1
+            if p == ugoal:
+                code = CODE_SUCCESS
+                break
+            # ---- relax the 8 moves k = 0..7 (the word's move bits k << 1; row, col steps
+            # (0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1), as in
+            # _trace), written out: the queue order, which decides ties, is k's
+            g0 = gbuf[p]
+            ur = np.uint64(np.int64(pi) * invw)  # p // wp, off by at most one: corrected
+            if ur * uw > p:
+                ur -= one
+            elif ur * uw + uw <= p:
+                ur += one
+            dy = float(np.int64(ur) - gr)  # integers in floats: the heuristic's sums are exact
+            dx = float(np.int64(p - ur * uw) - gc)
+            se = cell[p + one]
+            sw = cell[p - one]
+            sn = cell[p + uw]
+            ss = cell[p - uw]
+            n = 0  # improved neighbours, queued below in this order
+            if se < closedv:
+                ng = g0 + 1.0
+                if se < openv or ng < gbuf[p + one]:
+                    cq[n], cf[n], n = p + one, ng + _h(dy, dx + 1.0, octile), n + 1
+                    gbuf[p + one], cell[p + one] = ng, openv
+            if sw < closedv:
+                ng = g0 + 1.0
+                if sw < openv or ng < gbuf[p - one]:
+                    cq[n], cf[n], n = p - one, ng + _h(dy, dx - 1.0, octile), n + 1
+                    gbuf[p - one], cell[p - one] = ng, openv | np.uint32(1 << 1)
+            if sn < closedv:
+                ng = g0 + 1.0
+                if sn < openv or ng < gbuf[p + uw]:
+                    cq[n], cf[n], n = p + uw, ng + _h(dy + 1.0, dx, octile), n + 1
+                    gbuf[p + uw], cell[p + uw] = ng, openv | np.uint32(2 << 1)
+            if ss < closedv:
+                ng = g0 + 1.0
+                if ss < openv or ng < gbuf[p - uw]:
+                    cq[n], cf[n], n = p - uw, ng + _h(dy - 1.0, dx, octile), n + 1
+                    gbuf[p - uw], cell[p - uw] = ng, openv | np.uint32(3 << 1)
+            # a diagonal move needs both orthogonal cells it passes free (bit 0 clear: the
+            # words read above; a relaxation never changes bit 0) unless corners may be cut
+            fe = (se & bit0) == 0
+            fw = (sw & bit0) == 0
+            fn = (sn & bit0) == 0
+            fs = (ss & bit0) == 0
+            ng = g0 + s2
+            if corner_cutting or (fn and fe):
+                q = p + uw + one
+                st = cell[q]
+                if st < closedv and (st < openv or ng < gbuf[q]):
+                    cq[n], cf[n], n = q, ng + _h(dy + 1.0, dx + 1.0, octile), n + 1
+                    gbuf[q], cell[q] = ng, openv | np.uint32(4 << 1)
+            if corner_cutting or (fn and fw):
+                q = p + uw - one
+                st = cell[q]
+                if st < closedv and (st < openv or ng < gbuf[q]):
+                    cq[n], cf[n], n = q, ng + _h(dy + 1.0, dx - 1.0, octile), n + 1
+                    gbuf[q], cell[q] = ng, openv | np.uint32(5 << 1)
+            if corner_cutting or (fs and fe):
+                q = p - uw + one
+                st = cell[q]
+                if st < closedv and (st < openv or ng < gbuf[q]):
+                    cq[n], cf[n], n = q, ng + _h(dy - 1.0, dx + 1.0, octile), n + 1
+                    gbuf[q], cell[q] = ng, openv | np.uint32(6 << 1)
+            if corner_cutting or (fs and fw):
+                q = p - uw - one
+                st = cell[q]
+                if st < closedv and (st < openv or ng < gbuf[q]):
+                    cq[n], cf[n], n = q, ng + _h(dy - 1.0, dx - 1.0, octile), n + 1
+                    gbuf[q], cell[q] = ng, openv | np.uint32(7 << 1)
+            for j in range(n):
+                f = cf[j]
+                kf = _bits_of(f)
+                qi = np.int64(cq[j])
+                if use_ring:
+                    kq = np.int64(f * _RING_SCALE)
+                    if kq <= cur:  # the bucket being expanded (or below it, by rounding)
+                        ssize = _spush(skey, snode, ssize, kf, qi)
+                    else:
+                        if fh >= 0:
+                            e = fh
+                            fh = qnext[e]
+                        else:
+                            e = used
+                            used += 1
+                        qkey[e] = kf
+                        qnode[e] = qi
+                        b = kq & rmask
+                        qnext[e] = heads[b]
+                        heads[b] = e
+                        bits[b >> 6] |= one << np.uint64(b & 63)
+                        size += 1
+                else:
+                    fh, used = _qpush(qkey, qnode, qnext, heads, last, fh, used, kf, qi)
+                    size += 1
+        meta[0] = cur if use_ring else np.int64(last)
+        meta[1] = fh
+        meta[2] = used
+        meta[3] = size
+        meta[4] = ssize
+        return code, n_exp
+
+    return kernel
+
+
+_astar_ring = _make_kernel(True)  # the euclidean heuristic's kernel
+_astar_radix = _make_kernel(False)  # the octile heuristic's kernel
 
 
 @njit(cache=True, nogil=True)

@@ -132,10 +132,14 @@ def _from(plugin: str | None) -> str:
     return f" (plug-in {plugin!r})" if plugin else ""
 
 
-def warm_global(name: str) -> None:
-    """Compile (or load from numba's cache) the kernels of the global planner ``name``."""
+def warm_global(name: str, heuristic: str | None = None) -> None:
+    """Compile (or load from numba's cache) the kernels of the global planner ``name``;
+    for ``astar`` and ``astar-smooth``, A*'s kernel of ``heuristic`` only (each heuristic
+    has its own; None: both)."""
     gs = get_global_planner(name)
-    if gs.warmup is not None:
+    if gs.warmup is not None and gs.warmup in _BY_HEURISTIC and heuristic is not None:
+        gs.warmup(heuristic)
+    elif gs.warmup is not None:
         gs.warmup()
 
 
@@ -247,10 +251,10 @@ def _from_result(out: Any, problem: Problem, elapsed: float, what: str) -> Globa
 
 
 # --------------------------------------------------------------------------- warm-ups
-def _warm_astar() -> None:
-    from pathfuse.search.astar import warmup
+def _warm_astar(heuristic: str | None = None) -> None:
+    from pathfuse.search.astar import HEURISTICS, warmup
 
-    warmup()
+    warmup(HEURISTICS if heuristic is None else (heuristic,))
 
 
 def _warm_jps() -> None:
@@ -259,10 +263,10 @@ def _warm_jps() -> None:
     warmup()
 
 
-def _warm_smooth() -> None:
+def _warm_smooth(heuristic: str | None = None) -> None:
     from pathfuse.search.los import smooth_path
 
-    _warm_astar()
+    _warm_astar(heuristic)
     occ = np.zeros((3, 3), bool)
     occ.setflags(write=False)  # as GridMap.occupied: numba types read-only arrays apart
     smooth_path(np.array([[0.5, 0.5], [1.5, 0.5], [2.5, 1.5]]), occ, 0.0, 0.0, 1.0, 1e-6)
@@ -277,14 +281,14 @@ def _warm_theta(lazy: bool) -> None:
 def _warm_shortest() -> None:
     from pathfuse.search import visibility
 
-    _warm_astar()
+    _warm_astar("octile")  # the A* run that bounds the search
     visibility.warmup()
 
 
 def _k_astar() -> Sequence[Any]:
-    from pathfuse.search.kernel import _astar_kernel
+    from pathfuse.search.kernel import _astar_ring
 
-    return (_astar_kernel,)
+    return (_astar_ring,)  # the default heuristic's (euclidean)
 
 
 def _k_jps() -> Sequence[Any]:
@@ -306,10 +310,13 @@ def _k_theta() -> Sequence[Any]:
 
 
 def _k_shortest() -> Sequence[Any]:
+    from pathfuse.search.kernel import _astar_radix
     from pathfuse.search.visibility import _vis_kernel, convex_corners
 
-    return (*_k_astar(), _vis_kernel, convex_corners)
+    return (_astar_radix, _vis_kernel, convex_corners)
 
+
+_BY_HEURISTIC = (_warm_astar, _warm_smooth)  # warm-ups that take the A* heuristic
 
 register_global_planner(
     "astar", _astar, "exact 8-connected grid A* on the robot's c-space (the planner's "

@@ -226,3 +226,22 @@ def test_head_on_disc_swerves_where_standing_still_is_hit():
         assert ep.status is Status.SUCCESS, ep.message
         assert ep.min_obstacle_distance_m > 0.0
         assert np.abs(ep.positions[:, 1] - 2.5).max() > 0.3  # it stepped aside
+
+
+@pytest.mark.parametrize("dwell_s", [0.0, 1.5])  # below and at the escape's own dwell
+def test_lane_escape_scores_against_the_current_path(dwell_s):
+    # the lane escape's settings follow every new path: after a replan its path search
+    # (seg_max_m) is the new path's, not the first one's; the escape's dwell critic stays
+    from pathfuse.planners.controllers.dwa_escape import ESCAPE_DWELL_S
+
+    w = World(dict(HALL, robot=DIFF))
+    w.reset(0)
+    m = w.robot
+    pb = Problem.create(w.scenario.grid, w.scenario.start, w.scenario.goal, m.radius_m, robot=m)
+    ctrl = start_online(get_planner("mppi"), pb, MPPIParams(dwell_s=dwell_s), w.dt,
+                        m.max_speed_mps)
+    first = ctrl.f_escape.seg_max_m
+    ctrl._set_path(np.array([[1.5, 2.5], [7.5, 2.5], [13.5, 2.5]]))  # 6 m segments
+    assert ctrl.f.seg_max_m == pytest.approx(6.0) != first
+    assert ctrl.f_escape.seg_max_m == ctrl.f.seg_max_m
+    assert ctrl.f_escape.dwell_s == max(dwell_s, ESCAPE_DWELL_S)

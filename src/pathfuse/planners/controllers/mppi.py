@@ -273,9 +273,6 @@ class MPPIController(Controller):
             min(vmax, p.slow_guide_speed_mps), p.keep_better_guide,
             w_social=p.social_weight if p.social else 0.0, personal_m=p.personal_m,
             dwell_s=p.dwell_s if p.social else 0.0, w_dwell=p.dwell_weight)
-        # the lane escape's scoring carries the dwell critic even where mppi's own is off
-        self.f_escape = self.f if self.f.dwell_s >= ESCAPE_DWELL_S else self.f._replace(
-            dwell_s=ESCAPE_DWELL_S, dwell_weight=p.dwell_weight)
         self._baseline()
         n, k = int(p.time_steps), int(p.batch_size)
         self.nominal = np.zeros((n, 2))
@@ -305,6 +302,10 @@ class MPPIController(Controller):
             self._baseline()
 
     def _baseline(self) -> None:
+        # the lane escape's scoring carries the dwell critic even where mppi's own is off;
+        # made again with every path (its seg_max_m is the path's)
+        self.f_escape = self.f if self.f.dwell_s >= ESCAPE_DWELL_S else self.f._replace(
+            dwell_s=ESCAPE_DWELL_S, dwell_weight=self.params.dwell_weight)
         self.pexp = path_inflation(self.costmap, self.f, self.pts,
                                    bool(self.params.relative_inflation))
 

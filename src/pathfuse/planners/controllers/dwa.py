@@ -95,6 +95,8 @@ from pathfuse.planners.base import Controller, Observed, Outcome, sensed_discs
 from pathfuse.planners.controllers.dwa_checks import NO_NEAR, NearSquares, near_squares
 from pathfuse.planners.controllers.dwa_escape import escape_command
 from pathfuse.planners.controllers.dwa_kernel import (
+    KEEP_M,
+    KEEP_WEIGHT,
     DwaTick,
     dwa_choose_near,
     dwa_tick,
@@ -147,11 +149,14 @@ class DWAParams(SocialParams, GlobalAStarParams, GlobalChoice):
     heading_weight: float = param(0.3, ge=0, help="heading critic (per half turn)")
     speed_weight: float = param(0.2, ge=0, help="speed critic (slower = worse)")
     obstacle_weight: float = param(0.5, ge=0, help="obstacle critic (static gap)")
-    keep_weight: float = param(5.0, ge=0,
+    keep_weight: float = param(KEEP_WEIGHT, ge=0,
                                help="keep critic (ours): the shortfall of the rollout's least "
                                     "static gap within keep_horizon_s against the gap the "
-                                    "global path keeps ahead (up to keep_m), squared; 0 = off")
-    keep_m: float = param(0.3, gt=0, unit="m", help="keep critic: the most gap it asks for")
+                                    "global path keeps ahead (up to keep_m), squared; 0 = off "
+                                    "(5 before issue 17's clearance round)")
+    keep_m: float = param(KEEP_M, gt=0, unit="m",
+                          help="keep critic: the most gap it asks for (0.3 before issue 17's "
+                               "clearance round)")
     keep_horizon_s: float = param(1.0, gt=0, unit="s",
                                   help="keep critic: how far along each rollout it looks")
     path_align_weight: float = param(1.0, ge=0, unit="1/m",

@@ -34,11 +34,22 @@ from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
 from pathfuse.sweep import arc_deviation_bound, unicycle_pose
 
 __all__ = ["dwa_choose", "dwa_choose_near", "dwa_progress", "pack_dwa", "path_gap", "relaxed",
-           "dwa_tick", "keep_reference", "route_tangent", "DwaSettings", "DwaTick"]
+           "dwa_tick", "keep_reference", "route_tangent", "DwaSettings", "DwaTick", "KEEP_M",
+           "KEEP_WEIGHT"]
 
 SOFT = 0.3
 KEEP_FLOOR = 0.02
 """The keep critic's shortfall is relative to the path's gap, but to at least this (m)."""
+KEEP_WEIGHT = 10.0
+"""The keep critic's default weight (``dwa.keep_weight`` and the fusion's window; 5 before
+issue 17's clearance round, 26 Nov 2026)."""
+KEEP_M = 0.15
+"""The most gap the keep critic asks for by default (``dwa.keep_m``, m; 0.3 before issue 17's
+clearance round).  The critic asks for the gap the global path keeps ahead, up to this: at a
+narrowing the path's own gap (on BARN 0.04-0.1 m) is asked for whatever ``keep_m`` is, so a
+smaller cap leaves the narrowings' term as it was and stops charging samples that pass
+0.15-0.3 m from a cylinder in the open, which made the robot slow and swerve there; that is
+what lets the weight double at no cost in speed (docs/results/barn.md)."""
 PASSIVE_COST = 20.0
 
 

@@ -90,6 +90,7 @@ from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
 from pathfuse.field.settings import pack_fusion
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController, _plain, sensed_discs
+from pathfuse.planners.controllers.dwa_kernel import KEEP_M, KEEP_WEIGHT
 from pathfuse.planners.controllers.replan import replan_around_discs
 from pathfuse.planners.controllers.social import disc_ids
 from pathfuse.planners.params import (
@@ -200,6 +201,14 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
     replan_new: bool = param(
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")
+    keep_weight: float = param(
+        KEEP_WEIGHT, ge=0, le=1e6,
+        help="diff-drive robot online, velocity space: the window's keep critic (dwa's "
+             "keep_weight, ours: the rollout's shortfall from the gap the A* path keeps "
+             "ahead); 0 = off (5 before issue 17's clearance round)")
+    keep_m: float = param(KEEP_M, gt=0, le=100, unit="m",
+                          help="diff-drive robot online, velocity space: the most gap the "
+                               "window's keep critic asks for (dwa's keep_m; 0.3 before)")
     velocity_space: bool = param(True, help="diff-drive robot online: choose (v, omega) from "
                                             "the dynamic window by agreement with Algorithm "
                                             "2's move, clearance and the predicted discs "
@@ -246,7 +255,8 @@ class FusionController(FieldController):
             from pathfuse.planners.controllers.fusion_window import ForceWindow
 
             self._window = ForceWindow(problem, float(self.dt),  # type: ignore[arg-type]
-                                       social=p, among_discs=p.among_discs, seed=p.seed)
+                                       social=p, among_discs=p.among_discs, seed=p.seed,
+                                       keep=(p.keep_weight, p.keep_m))
         self._ticks = 0
         self._seen: set[int] = set()
         self.escapes_given_up = 0

@@ -146,14 +146,19 @@ class ForceWindow:
         sampled sequences, or the dynamic window as without discs.
     seed : int
         Seed of MPPI's sampling noise.
+    keep : (float, float), optional
+        The keep critic's weight and the most gap it asks for (the fusion's ``keep_weight``
+        and ``keep_m``; default: ``dwa``'s).
     """
 
     def __init__(self, problem: Any, dt: float, social: Any = None,
-                 among_discs: str = "mppi", seed: int = 0) -> None:
+                 among_discs: str = "mppi", seed: int = 0,
+                 keep: tuple[float, float] | None = None) -> None:
         from pathfuse.planners.controllers.dwa import DWAParams
 
         rb = problem.robot
         p = DWAParams()
+        w_keep, keep_m = (p.keep_weight, p.keep_m) if keep is None else keep
         sp = p if social is None else social
         self.social = sp
         self.among_discs = among_discs
@@ -175,8 +180,8 @@ class ForceWindow:
             p.w_samples, p.path_weight, p.goal_weight, p.heading_weight, p.speed_weight,
             p.obstacle_weight, p.moving_weight, p.obstacle_range_m, p.lookahead_m,
             p.inflation_decay_m, False, PASSIVE_WINDOW,
-            w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=p.keep_weight,
-            keep_m=p.keep_m, w_social=sp.social_weight if sp.social else 0.0,
+            w_align=p.path_align_weight, near_s=p.keep_horizon_s, w_keep=w_keep,
+            keep_m=keep_m, w_social=sp.social_weight if sp.social else 0.0,
             personal_m=sp.personal_m, w_side=sp.side_weight if sp.social else 0.0,
             dwell_s=sp.dwell_s if sp.social else 0.0, w_dwell=sp.dwell_weight)
         self.sides = PassingSides(sp.personal_m)

@@ -21,8 +21,20 @@ from pathfuse.result import ConfigError
 from pathfuse.search.astar import HEURISTICS
 from pathfuse.validate import ParamSpec, check_fields, param
 
+KEEP_WEIGHT = 10.0
+"""The keep critic's default weight (``dwa.keep_weight`` and the fusion's window; 5 before
+issue 17's clearance round, 26 Nov 2026)."""
+KEEP_M = 0.15
+"""The most gap the keep critic asks for by default (``dwa.keep_m``, m; 0.3 before issue 17's
+clearance round).  The critic asks for the gap the global path keeps ahead, up to this: at a
+narrowing the path's own gap (on BARN 0.04-0.1 m) is asked for whatever ``keep_m`` is, so a
+smaller cap leaves the narrowings' term as it was and stops charging samples that pass
+0.15-0.3 m from a cylinder in the open, which made the robot slow and swerve there; that is
+what lets the weight double at no cost in speed (docs/results/barn.md)."""
+
 __all__ = ["Checked", "GlobalChoice", "GlobalAStarParams", "FieldParams", "DiscParams",
-           "PursuitParams", "PersonalSpaceParams", "SocialParams", "BOUNDS"]
+           "PursuitParams", "PersonalSpaceParams", "SocialParams", "BOUNDS", "KEEP_M",
+           "KEEP_WEIGHT"]
 
 _BIG = 1e6  # gains, weights and costs
 BOUNDS: dict[str, tuple[float | None, float]] = {

@@ -30,6 +30,7 @@ from pathfuse.planners.controllers.dwa_checks import (
 )
 from pathfuse.planners.controllers.dwa_route import _local_goal, _wrap, dwa_progress, route_tangent
 from pathfuse.planners.controllers.social import EVERY_DISC, dwell_shortfall
+from pathfuse.planners.params import KEEP_M, KEEP_WEIGHT
 from pathfuse.shield import holonomic_stop_disc_gap, unicycle_stop_disc_gap
 from pathfuse.sweep import arc_deviation_bound, unicycle_pose
 
@@ -40,16 +41,6 @@ __all__ = ["dwa_choose", "dwa_choose_near", "dwa_progress", "pack_dwa", "path_ga
 SOFT = 0.3
 KEEP_FLOOR = 0.02
 """The keep critic's shortfall is relative to the path's gap, but to at least this (m)."""
-KEEP_WEIGHT = 10.0
-"""The keep critic's default weight (``dwa.keep_weight`` and the fusion's window; 5 before
-issue 17's clearance round, 26 Nov 2026)."""
-KEEP_M = 0.15
-"""The most gap the keep critic asks for by default (``dwa.keep_m``, m; 0.3 before issue 17's
-clearance round).  The critic asks for the gap the global path keeps ahead, up to this: at a
-narrowing the path's own gap (on BARN 0.04-0.1 m) is asked for whatever ``keep_m`` is, so a
-smaller cap leaves the narrowings' term as it was and stops charging samples that pass
-0.15-0.3 m from a cylinder in the open, which made the robot slow and swerve there; that is
-what lets the weight double at no cost in speed (docs/results/barn.md)."""
 PASSIVE_COST = 20.0
 
 

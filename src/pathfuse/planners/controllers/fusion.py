@@ -90,10 +90,10 @@ from pathfuse.field.repulsion import AHEAD_PAPER_X, AHEAD_PROGRESS, fusion_force
 from pathfuse.field.settings import pack_fusion
 from pathfuse.grid import GridMap
 from pathfuse.planners.base import FieldController, _plain, sensed_discs
-from pathfuse.planners.controllers.dwa_kernel import KEEP_M
 from pathfuse.planners.controllers.replan import replan_around_discs
 from pathfuse.planners.controllers.social import disc_ids
 from pathfuse.planners.params import (
+    KEEP_M,
     DiscParams,
     FieldParams,
     GlobalAStarParams,
@@ -114,7 +114,7 @@ FUSION_STEP_FRAC = 0.5
 
 FUSION_KEEP_WEIGHT = 7.0
 """The fusion window's keep-critic weight by default (dwa's is
-:data:`~pathfuse.planners.controllers.dwa_kernel.KEEP_WEIGHT`, 10): on the 250 shipped BARN
+:data:`~pathfuse.planners.params.KEEP_WEIGHT`, 10): on the 250 shipped BARN
 worlds at 10 the fusion stood before narrowings and then passed them within 5 mm in 21
 worlds at 1 m/s (6 at 5); at 7 its least clearance's 5th percentile stays 0.016-0.020 m and
 its median 0.060-0.061 m at 1 and 2 m/s."""

@@ -79,12 +79,11 @@ def _expected(w_keep: float, keep_m: float, gap: float, gref: float) -> float:
 
 
 def test_the_defaults_are_the_new_ones() -> None:
-    from pathfuse.planners.controllers.fusion import FUSION_KEEP_WEIGHT, FusionParams
+    from pathfuse.planners.controllers.fusion import FusionParams
 
     p, fp = DWAParams(), FusionParams()
     assert (p.keep_weight, p.keep_m) == (KEEP_WEIGHT, KEEP_M) == (10.0, 0.15)
-    # the fusion's window asks for less (at 10 it grazed more on BARN)
-    assert (fp.keep_weight, fp.keep_m) == (FUSION_KEEP_WEIGHT, KEEP_M) == (7.0, 0.15)
+    assert (fp.keep_weight, fp.keep_m) == (KEEP_WEIGHT, KEEP_M)
 
 
 @pytest.mark.parametrize("gap, gref", [(0.2, 0.3), (0.1, 0.3), (0.04, 0.08), (0.07, 0.08),
@@ -136,4 +135,4 @@ def test_fusion_params_reach_its_window() -> None:
     assert (c._window.f.keep_weight, c._window.f.keep_m) == (3.0, 0.2)
     c = FusionController(pb, FusionParams(among_discs="window"), _Plan(), dt=0.1,
                          max_speed=1.0)
-    assert (c._window.f.keep_weight, c._window.f.keep_m) == (7.0, 0.15)
+    assert (c._window.f.keep_weight, c._window.f.keep_m) == (KEEP_WEIGHT, KEEP_M)

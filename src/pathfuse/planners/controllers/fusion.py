@@ -94,6 +94,7 @@ from pathfuse.planners.controllers.replan import replan_around_discs
 from pathfuse.planners.controllers.social import disc_ids
 from pathfuse.planners.params import (
     KEEP_M,
+    KEEP_WEIGHT,
     DiscParams,
     FieldParams,
     GlobalAStarParams,
@@ -110,14 +111,6 @@ _AHEAD = {"progress": AHEAD_PROGRESS, "paper-x": AHEAD_PAPER_X}
 
 #: Default step of the fusion planner offline, as a fraction of the map resolution.
 FUSION_STEP_FRAC = 0.5
-
-
-FUSION_KEEP_WEIGHT = 7.0
-"""The fusion window's keep-critic weight by default (dwa's is
-:data:`~pathfuse.planners.params.KEEP_WEIGHT`, 10): on the 250 shipped BARN
-worlds at 10 the fusion stood before narrowings and then passed them within 5 mm in 21
-worlds at 1 m/s (6 at 5); at 7 its least clearance's 5th percentile stays 0.016-0.020 m and
-its median 0.060-0.061 m at 1 and 2 m/s."""
 
 
 @dataclass(frozen=True)
@@ -210,11 +203,10 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")
     keep_weight: float = param(
-        FUSION_KEEP_WEIGHT, ge=0, le=1e6,
+        KEEP_WEIGHT, ge=0, le=1e6,
         help="diff-drive robot online, velocity space: the window's keep critic (dwa's "
              "keep_weight, ours: the rollout's shortfall from the gap the A* path keeps "
-             "ahead); 0 = off (5 before issue 17's clearance round; 7, below dwa's 10, "
-             "because at 10 the fusion grazed more: docs/results/barn.md)")
+             "ahead); 0 = off (5 before issue 17's clearance round)")
     keep_m: float = param(KEEP_M, gt=0, le=100, unit="m",
                           help="diff-drive robot online, velocity space: the most gap the "
                                "window's keep critic asks for (dwa's keep_m; 0.3 before)")

@@ -145,19 +145,10 @@ class Problem:
                                   f"robot_radius_m ({float(r):g})")
         ox, oy = grid.origin
         res = grid.resolution
-        # _made's body, written out (a query's every call counts: issue 21)
-        obj = object.__new__(cls)
-        d = obj.__dict__
-        d["grid"] = grid
-        d["start"] = s
-        d["goal"] = g
-        d["robot_radius_m"] = float(r)
-        d["budget"] = budget
-        d["start_cell"] = (math.floor((s[1] - oy) / res), math.floor((s[0] - ox) / res))
-        d["goal_cell"] = (math.floor((g[1] - oy) / res), math.floor((g[0] - ox) / res))
-        d["clearance_m"] = c
-        d["robot"] = robot
-        return obj
+        return cls._made(grid, s, g, float(r), budget,
+                         (math.floor((s[1] - oy) / res), math.floor((s[0] - ox) / res)),
+                         (math.floor((g[1] - oy) / res), math.floor((g[0] - ox) / res)),
+                         c, robot)
 
     @classmethod
     def _made(cls, grid: GridMap, start: tuple[float, float], goal: tuple[float, float],

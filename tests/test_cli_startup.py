@@ -117,8 +117,15 @@ def test_each_heuristic_compiles_its_own_a_star_kernel(tmp_path):
             "print(is_cached(_astar_ring), is_cached(_astar_radix))\n"
             "warmup(('euclidean',))\n"
             "print(len(_astar_ring.signatures), len(_astar_radix.signatures))\n"
-            "print(is_cached(_astar_ring), is_cached(_astar_radix))\n")
+            "print(is_cached(_astar_ring), is_cached(_astar_radix))\n"
+            "from pathfuse.planners.kernel_cache import cold_kernels\n"
+            "from pathfuse.planners.registry import get_planner, make_params\n"
+            "s = get_planner('astar')\n"
+            "print(len(cold_kernels(s, make_params(s, {'heuristic': 'euclidean'}))),\n"
+            "      len(cold_kernels(s, make_params(s, {'heuristic': 'octile'}))))\n")
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, timeout=600, env=env)
-    assert out.stdout.split("\n")[:3] == ["False False", "1 0", "True False"], out.stdout
+    # the notice for an octile plan: its kernel is still cold though the euclidean one is not
+    assert out.stdout.split("\n")[:4] == ["False False", "1 0", "True False", "0 1"], \
+        out.stdout

@@ -62,7 +62,8 @@ def cold_kernels(spec: Any, params: Any = None, diff_drive: bool = False,
     if gname is not None:
         from pathfuse.planners.globals.builtin import global_kernels
 
-        kernels.extend(global_kernels(gname))
+        # the A* kernel of the heuristic the plan runs, as warm() compiles it
+        kernels.extend(global_kernels(gname, getattr(params, "heuristic", None)))
     if spec.controller is not None:
         kernels.extend(spec.controller.kernels())
         if diff_drive:

@@ -143,10 +143,16 @@ def warm_global(name: str, heuristic: str | None = None) -> None:
         gs.warmup()
 
 
-def global_kernels(name: str) -> Sequence[Any]:
-    """The numba kernels of the global planner ``name`` (to tell a cold cache)."""
+def global_kernels(name: str, heuristic: str | None = None) -> Sequence[Any]:
+    """The numba kernels of the global planner ``name`` (to tell a cold cache); for
+    ``astar`` and ``astar-smooth``, A*'s kernel of ``heuristic`` (None: the default's), as
+    :func:`warm_global` compiles it."""
     gs = get_global_planner(name)
-    return tuple(gs.kernels()) if gs.kernels is not None else ()
+    if gs.kernels is None:
+        return ()
+    if gs.kernels in _KERNELS_BY_HEURISTIC and heuristic is not None:
+        return tuple(gs.kernels(heuristic))
+    return tuple(gs.kernels())
 
 
 # --------------------------------------------------------------------------- the built-ins
@@ -285,10 +291,11 @@ def _warm_shortest() -> None:
     visibility.warmup()
 
 
-def _k_astar() -> Sequence[Any]:
-    from pathfuse.search.kernel import _astar_ring
+def _k_astar(heuristic: str | None = None) -> Sequence[Any]:
+    from pathfuse.search.kernel import _astar_radix, _astar_ring
 
-    return (_astar_ring,)  # the default heuristic's (euclidean)
+    # each heuristic has its own kernel; None: the default's (euclidean)
+    return (_astar_radix if heuristic == "octile" else _astar_ring,)
 
 
 def _k_jps() -> Sequence[Any]:
@@ -297,10 +304,10 @@ def _k_jps() -> Sequence[Any]:
     return (_jps_kernel,)
 
 
-def _k_smooth() -> Sequence[Any]:
+def _k_smooth(heuristic: str | None = None) -> Sequence[Any]:
     from pathfuse.search.los import smooth_path
 
-    return (*_k_astar(), smooth_path)
+    return (*_k_astar(heuristic), smooth_path)
 
 
 def _k_theta() -> Sequence[Any]:
@@ -317,6 +324,7 @@ def _k_shortest() -> Sequence[Any]:
 
 
 _BY_HEURISTIC = (_warm_astar, _warm_smooth)  # warm-ups that take the A* heuristic
+_KERNELS_BY_HEURISTIC = (_k_astar, _k_smooth)  # and their kernel lists
 
 register_global_planner(
     "astar", _astar, "exact 8-connected grid A* on the robot's c-space (the planner's "

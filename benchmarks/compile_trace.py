@@ -3,8 +3,9 @@
 Runs a pathfuse command line in this process with numba's compile events
 recorded: every function numba compiles (a dispatcher's own compilation; a
 callee's inside its caller's is counted apart, so the times are *exclusive*),
-split into type inference, lowering (LLVM IR, optimisation, machine code) and
-the rest of numba's pipeline, and every overload looked up in the on-disk cache
+split into type inference, lowering (numba writing LLVM IR, and linking), LLVM's
+own work (its optimisation passes and its machine code: the part ``NUMBA_OPT``
+sets) and the rest of numba's pipeline, and every overload looked up in the on-disk cache
 (hit or miss). numba's own start-up (its first compilation in a process, of a
 one-line function) runs first and is left out of the figures. The pathfuse
 modules imported are listed at the end.
@@ -68,6 +69,23 @@ def main(argv: list[str]) -> None:
 
     timed(typed_passes.NopythonTypeInference, "typing")
     timed(typed_passes.NativeLowering, "lowering")
+    from llvmlite.binding import executionengine, newpassmanagers
+
+    def llvm(cls: Any, method: str) -> None:
+        run = getattr(cls, method)
+
+        def wrapper(self: Any, *args: Any) -> Any:
+            push(stack[-1][0] if stack else "?", "llvm")
+            try:
+                return run(self, *args)
+            finally:
+                pop()
+
+        setattr(cls, method, wrapper)
+
+    llvm(newpassmanagers.ModulePassManager, "run")
+    llvm(newpassmanagers.FunctionPassManager, "run")
+    llvm(executionengine.ExecutionEngine, "finalize_object")
     event.register("numba:compile", Listener())
     load_overload = caching.Cache.load_overload
 
@@ -89,10 +107,14 @@ def main(argv: list[str]) -> None:
         per[name][phase] = dt
     print(f"numba's own set-up {setup:.2f} s; the command {total:.2f} s of CPU, of which "
           f"compiling {sum(excl.values()):.2f} s ({len(per)} functions)")
-    print("   CPU s  typing lowering  other  function")
+    print("   CPU s  typing lowering  llvm   other  function")
     for name, d in sorted(per.items(), key=lambda kv: -sum(kv[1].values())):
         print(f"  {sum(d.values()):6.2f}  {d.get('typing', 0):6.2f}  {d.get('lowering', 0):6.2f} "
-              f"{d.get('other', 0):6.2f}  {name}")
+              f"{d.get('llvm', 0):6.2f} {d.get('other', 0):6.2f}  {name}")
+    tot = {ph: sum(d.get(ph, 0.0) for d in per.values())
+           for ph in ("typing", "lowering", "llvm", "other")}
+    print(f"  {sum(tot.values()):6.2f}  {tot['typing']:6.2f}  {tot['lowering']:6.2f} "
+          f"{tot['llvm']:6.2f} {tot['other']:6.2f}  (all)")
     hits = [n for n, hit in loads if hit]
     print(f"cache: {len(hits)} loaded ({', '.join(hits)}), {len(loads) - len(hits)} missed")
     mods = sorted(m for m in sys.modules if m.startswith("pathfuse"))

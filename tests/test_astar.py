@@ -476,3 +476,23 @@ def test_small_heap_orders_exactly():
             opened = (word != 0xFFFFFFFF) & ((word >> 5) == s._closed_gen - 1)
             assert closed.sum() == k and opened.any()
             assert f[closed].max() <= f[opened].min()
+
+
+def test_fetch_is_a_hint_that_changes_nothing():
+    """The kernel's prefetch (one intrinsic for the six addresses an expansion reads: the
+    rows above, at and below a cell, in the cell words and in ``g``) compiles in a numba
+    function, returns nothing and leaves both arrays as they were."""
+    from numba import njit
+
+    @njit
+    def fetch_all(cell, gbuf, uw):
+        for q in range(uw, cell.shape[0] - uw):
+            kernel_mod._fetch(cell, gbuf, np.uint64(q), np.uint64(uw))
+        return cell.sum(), gbuf.sum()
+
+    rng = np.random.default_rng(3)
+    cell = rng.integers(0, 2**32, 7 * 9, dtype=np.uint64).astype(np.uint32)
+    gbuf = rng.random(7 * 9)
+    before = cell.copy(), gbuf.copy()
+    fetch_all(cell, gbuf, 9)
+    assert np.array_equal(cell, before[0]) and np.array_equal(gbuf, before[1])

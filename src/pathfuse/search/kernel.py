@@ -46,36 +46,32 @@ def _bits_of(typingctx, x):
 
 
 @intrinsic
-def _prefetch(typingctx, arr, idx):
-    """Ask the CPU to bring ``arr[idx]`` into its caches (LLVM ``prefetch``, read, high
-    locality); no effect on what the program computes."""
-    sig = types.void(arr, idx)
+def _fetch(typingctx, cell, gbuf, q, uw):
+    """Prefetch what expanding cell ``q`` reads: its row and the rows above and below
+    (``q - uw``, ``q``, ``q + uw``), in the cell words and in ``g`` (at 4096 x 4096 cells the
+    search waits on memory).  LLVM ``prefetch`` (read, high locality); no effect on what the
+    program computes.  An intrinsic, not a numba function inlined at each call site, so
+    numba types one call per site instead of a body (issue 21: the kernel's first compile)."""
+    sig = types.void(cell, gbuf, q, uw)
 
     def codegen(context, builder, signature, args):
-        ary = context.make_array(signature.args[0])(context, builder, args[0])
         i8p = ir.IntType(8).as_pointer()
         i32 = ir.IntType(32)
         # declare_intrinsic mangles the name for llvmlite's pointer type ("p0i8"), which the
         # LLVM of every numba we support reads (newer ones upgrade it to the opaque "p0")
         fn = builder.module.declare_intrinsic(
             "llvm.prefetch", [i8p], ir.FunctionType(ir.VoidType(), [i8p, i32, i32, i32]))
-        ptr = builder.bitcast(builder.gep(ary.data, [args[1]]), i8p)
-        builder.call(fn, [ptr, ir.Constant(i32, 0), ir.Constant(i32, 3), ir.Constant(i32, 1)])
+        q, uw = args[2], args[3]
+        idx = (builder.sub(q, uw), q, builder.add(q, uw))
+        for k in (0, 1):
+            ary = context.make_array(signature.args[k])(context, builder, args[k])
+            for i in idx:
+                ptr = builder.bitcast(builder.gep(ary.data, [i]), i8p)
+                builder.call(fn, [ptr, ir.Constant(i32, 0), ir.Constant(i32, 3),
+                                  ir.Constant(i32, 1)])
         return context.get_dummy_value()
 
     return sig, codegen
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _fetch(cell, gbuf, q, uw):
-    """Prefetch what expanding cell ``q`` reads: its row and the rows above and below, in
-    the cell words and in ``g`` (at 4096 x 4096 cells the search waits on memory)."""
-    _prefetch(cell, q - uw)
-    _prefetch(cell, q)
-    _prefetch(cell, q + uw)
-    _prefetch(gbuf, q - uw)
-    _prefetch(gbuf, q)
-    _prefetch(gbuf, q + uw)
 
 
 @njit(cache=True, nogil=True)

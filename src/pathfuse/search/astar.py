@@ -418,9 +418,7 @@ def get_searcher(grid, corner_cutting: bool = False) -> AStarSearcher:
     returned (its buffers are not cached).
     """
     key = bool(corner_cutting)
-    # a read needs no lock (the GIL); adding a map takes it.  The dictionary under the
-    # WeakKeyDictionary, keyed by a weak reference: its get() without a Python call
-    per_map = _CACHE.data.get(weakref.ref(grid))
+    per_map = _CACHE.get(grid)  # a read needs no lock (the GIL); adding a map takes it
     searcher = per_map.get(key) if per_map is not None else None
     if searcher is not None:
         return _new_searcher(grid, key, searcher._labels) if searcher.lock.locked() \

@@ -496,3 +496,36 @@ def test_fetch_is_a_hint_that_changes_nothing():
     before = cell.copy(), gbuf.copy()
     fetch_all(cell, gbuf, 9)
     assert np.array_equal(cell, before[0]) and np.array_equal(gbuf, before[1])
+
+
+def test_ring_left_empty_by_an_ended_query_and_cleared_after_a_stopped_one():
+    # the euclidean kernel clears its 4096 ring buckets only when the last query stopped
+    # midway (a budget or a time chunk) or the buffers are new; a query that ended (goal
+    # closed, region exhausted) empties the buckets it left: the next query must find
+    # every bucket empty, and a reused searcher answer as a fresh one, expansion for
+    # expansion, whatever came before
+    occ = np.random.default_rng(21).random((40, 50)) < 0.3
+    occ[:, 25] = True  # two regions: some queries end with NO_PATH
+    occ[20, 25] = False
+    pairs = _free_pairs(occ, 30, 22)
+    reused = AStarSearcher(occ, labels=np.ones(occ.shape, dtype=np.int64))  # no label answer
+    assert reused._meta[5] == 0  # new buffers (np.empty): cleared by the first query
+    reused._heads[:] = 7
+    reused._bits[:] = 12345
+    seen = set()
+    for i, (s, g) in enumerate(pairs):
+        ref = AStarSearcher(occ, labels=np.ones(occ.shape, dtype=np.int64)).search(s, g)
+        if i % 3 == 1 and ref.expansions > 2:  # stopped midway: the ring keeps entries
+            stop = reused.search(s, g, max_expansions=ref.expansions // 2)
+            assert stop.status is Status.MAX_ITERATIONS and reused._meta[5] == 0
+        if i % 3 == 2:  # the octile kernel's radix heap uses the first buckets' heads
+            reused.search(s, g, heuristic="octile")
+            assert reused._meta[5] == 0
+        r = reused.search(s, g)
+        seen.add(r.status)
+        assert (r.status, r.cost, r.expansions) == (ref.status, ref.cost, ref.expansions)
+        assert np.array_equal(r.cells, ref.cells) and np.array_equal(r.points, ref.points)
+        if r.expansions:  # a search ran to its end: it left the ring empty
+            assert reused._meta[5] == 1
+            assert np.all(reused._heads == -1) and not reused._bits.any()
+    assert seen >= {Status.SUCCESS, Status.NO_PATH}

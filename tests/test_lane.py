@@ -20,6 +20,7 @@ from pathfuse.planners.registry import (
     register,
     register_global_planner,
 )
+from pathfuse.problem import Problem
 
 
 def _maps() -> list[GridMap]:
@@ -171,3 +172,25 @@ def test_lane_bad_heuristic_is_the_layers_error(monkeypatch):
     with pytest.raises(ConfigError) as slow:
         run_mod.solve(spec, pb, P())
     assert str(fast.value) == str(slow.value)
+
+
+@pytest.mark.parametrize("radius", [0.0, 0.3])
+def test_solve_reports_the_problems_failure(radius):
+    # whatever the lane, a start or goal outside the map or blocked (for a point or a disc
+    # robot) ends plan() with failure()'s status and message
+    g = GridMap.from_rows(["....#", ".#...", "....."])
+    points = [(0.5, 0.5), (4.5, 2.5), (1.5, 1.5), (4.5, 2.9), (-0.5, 1.0), (2.0, 3.5),
+              (5.2, 0.5), (1.0, 0.99), (0.1, 2.9)]
+    seen = set()
+    for s in points:
+        for e in points:
+            bad = Problem.create(g, s, e, radius).failure()
+            r = pathfuse.plan(g, s, e, robot_radius_m=radius)
+            if bad is None:
+                assert r.status.name not in ("START_OUT_OF_BOUNDS", "GOAL_OUT_OF_BOUNDS",
+                                             "START_OCCUPIED", "GOAL_OCCUPIED")
+            else:
+                assert (r.status, r.message) == bad
+            seen.add(r.status.name)
+    assert {"SUCCESS", "START_OUT_OF_BOUNDS", "GOAL_OUT_OF_BOUNDS", "START_OCCUPIED",
+            "GOAL_OCCUPIED"} <= seen

@@ -27,7 +27,7 @@ from pathfuse.planners.globals.builtin import run_global
 from pathfuse.planners.registry import GLOBAL_PLANNERS, PlannerSpec, make_params
 from pathfuse.problem import Problem
 from pathfuse.result import ConfigError, PlanResult, Status, path_length
-from pathfuse.search.astar import HEURISTICS, get_searcher
+from pathfuse.search.astar import HEURISTICS, SearchResult, get_searcher
 from pathfuse.validate import short as _shown
 
 __all__ = ["solve", "start_online", "warm", "warm_query", "Stopped", "PlanInfo"]
@@ -217,23 +217,25 @@ def _astar_as_planned(spec: PlannerSpec, problem: Problem, params: Any) -> PlanR
     limit = budget.time_limit_s
     ox, oy = grid.origin
     res_m = grid.resolution
-    searcher = get_searcher(grid, corner_cutting=cut)
+    searcher = get_searcher(grid, cut)
     t0 = time.perf_counter()
-    res = searcher.search_checked(problem.start_cell, problem.goal_cell, heuristic,
-                                  budget.max_iterations, limit, (ox, oy, res_m))
+    status, cells, cost, expansions, points = searcher.search_fields(
+        problem.start_cell, problem.goal_cell, heuristic, budget.max_iterations, limit,
+        (ox, oy, res_m))
     elapsed = time.perf_counter() - t0
-    if res.status is not Status.SUCCESS:
-        gp = searched(problem, res, elapsed, limit, heuristic, cut)
+    if status is not Status.SUCCESS:
+        gp = searched(problem, SearchResult(status, cells, cost, expansions, points), elapsed,
+                      limit, heuristic, cut)
         return PlanResult(gp.status, time_s=gp.time_s, planner=spec.name,
                           expansions=gp.expansions, message=gp.message, info=_astar_info(gp))
-    length = res.cost * res_m
-    info = PlanInfo(cells=res.cells, cost_cells=length / res_m, heuristic=heuristic,
+    length = cost * res_m
+    info = PlanInfo(cells=cells, cost_cells=length / res_m, heuristic=heuristic,
                     corner_cutting=cut)
-    info._bound = (grid, res.points, float(problem.robot_radius_m))  # bind()'s body
+    info._bound = (grid, points, float(problem.robot_radius_m))  # bind()'s body
     # found_message's text, written out
-    return PlanResult._made(Status.SUCCESS, res.points, length, elapsed + 0.0, spec.name,
-                            res.expansions, 0, f"path through {len(res.cells)} cells, "
-                            f"{length:.6g} m, {res.expansions} expansions", info)
+    return PlanResult._made(Status.SUCCESS, points, length, elapsed + 0.0, spec.name,
+                            expansions, 0, f"path through {len(cells)} cells, "
+                            f"{length:.6g} m, {expansions} expansions", info)
 
 
 def _renamed(res: PlanResult, name: str) -> PlanResult:

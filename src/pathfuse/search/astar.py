@@ -96,7 +96,6 @@ from pathfuse.search.kernel import (
     _STAMP_LIMIT,
     _astar_radix,
     _astar_ring,
-    _trace,
 )
 from pathfuse.validate import short as _shown
 
@@ -220,7 +219,7 @@ class AStarSearcher(_Regions):
         self._snode = np.empty(cap, dtype=np.int32)
         self._heads = np.empty(_RING_SIZE, dtype=np.int32)
         self._bits = np.empty(_RING_SIZE // 64, dtype=np.uint64)
-        self._meta = np.zeros(5, dtype=np.int64)
+        self._meta = np.zeros(6, dtype=np.int64)  # see kernel._make_kernel
         self._cq = np.empty(8, dtype=np.uint64)  # the kernel's scratch: one expansion's
         self._cf = np.empty(8)  # queued neighbours and their f
         self._gen = 0
@@ -274,9 +273,8 @@ class AStarSearcher(_Regions):
                 raise QueryError(f"{what} cell ({r}, {c}) is outside the {h}x{w} grid")
             if self._cell[(r + 1) * self._wp + c + 1] == _BLOCKED:
                 raise QueryError(f"{what} cell ({r}, {c}) is occupied")
-        with self.lock:
-            return self._search(sr, sc, gr, gc, heuristic, max_expansions, time_limit_s,
-                                (0.0, 0.0, 1.0))
+        return SearchResult(*self.search_fields((sr, sc), (gr, gc), heuristic, max_expansions,
+                                                time_limit_s))
 
     def search_checked(self, start_cell: tuple[int, int], goal_cell: tuple[int, int],
                        heuristic: str, max_expansions: int | None,
@@ -285,62 +283,69 @@ class AStarSearcher(_Regions):
         """:meth:`search` for cells a :class:`~pathfuse.problem.Problem` has already checked
         (in bounds and free; the heuristic a known name): the checks are not repeated.
         ``origin`` is ``(x0, y0, resolution)`` of the map, for :attr:`SearchResult.points`."""
+        return SearchResult(*self.search_fields(start_cell, goal_cell, heuristic,
+                                                max_expansions, time_limit_s, origin))
+
+    def search_fields(self, start_cell: tuple[int, int], goal_cell: tuple[int, int],
+                      heuristic: str, max_expansions: int | None,
+                      time_limit_s: float | None,
+                      origin: tuple[float, float, float] = (0.0, 0.0, 1.0),
+                      ) -> tuple[Status, np.ndarray, float, int, np.ndarray]:
+        """:meth:`search_checked`'s fields ``(status, cells, cost, expansions, points)`` as a
+        tuple, without building the :class:`SearchResult` (the ``plan()`` lane,
+        :func:`pathfuse.planners.run._astar_as_planned`; the cells checked as for
+        :meth:`search_checked`).  The body of every search."""
         with self.lock:
-            return self._search(start_cell[0], start_cell[1], goal_cell[0], goal_cell[1],
-                                heuristic, max_expansions, time_limit_s, origin)
-
-    def _search(self, sr, sc, gr, gc, heuristic, max_expansions, time_limit_s,
-                origin) -> SearchResult:
-        t0 = time.perf_counter() if time_limit_s is not None else 0.0
-        self._closed_gen = -1
-        if sr == gr and sc == gc:
+            (sr, sc), (gr, gc) = start_cell, goal_cell
+            t0 = time.perf_counter() if time_limit_s is not None else 0.0
+            self._closed_gen = -1
+            if sr == gr and sc == gc:
+                ox, oy, res = origin
+                return (Status.SUCCESS, np.array([[sr, sc]], dtype=np.int64), 0.0, 0,
+                        np.array([[ox + (sc + 0.5) * res, oy + (sr + 0.5) * res]]))
+            labels = self._labels
+            if labels is not None and labels[sr, sc] != labels[gr, gc]:
+                return Status.NO_PATH, _NO_CELLS, math.inf, 0, _NO_POINTS
+            # a search never expands more than the free cells: a larger budget (even 10**30)
+            # means no cap, and stays within the kernel's 64-bit integers
+            budget = self.free_count if max_expansions is None else \
+                min(int(max_expansions), self.free_count)
+            wp = self._wp
+            start = (sr + 1) * wp + sc + 1
+            goal = (gr + 1) * wp + gc + 1
+            if self._gen >= _STAMP_LIMIT:
+                self._cell[self._cell != _BLOCKED] = 0
+                self._gen = 0
+            self._gen += 2
+            gen = self._gen
+            self._closed_gen = gen + 1
+            kernel = _KERNEL_ENTRY["octile" if heuristic == "octile" else "euclidean"]
+            chunk = _CHUNK if time_limit_s is not None else budget
+            done = 0
+            first = start
             ox, oy, res = origin
-            return SearchResult(Status.SUCCESS, np.array([[sr, sc]], dtype=np.int64), 0.0, 0,
-                                np.array([[ox + (sc + 0.5) * res, oy + (sr + 0.5) * res]]))
-        labels = self._labels
-        if labels is not None and labels[sr, sc] != labels[gr, gc]:
-            return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, 0)
-        # a search never expands more than the free cells: a larger budget (even 10**30)
-        # means no cap, and stays within the kernel's 64-bit integers
-        budget = self.free_count if max_expansions is None else \
-            min(int(max_expansions), self.free_count)
-        wp = self._wp
-        start = (sr + 1) * wp + sc + 1
-        goal = (gr + 1) * wp + gc + 1
-        if self._gen >= _STAMP_LIMIT:
-            self._cell[self._cell != _BLOCKED] = 0
-            self._gen = 0
-        self._gen += 2
-        gen = self._gen
-        self._closed_gen = gen + 1
-        kernel = _KERNEL_ENTRY["octile" if heuristic == "octile" else "euclidean"]
-        chunk = _CHUNK if time_limit_s is not None else budget
-        done = 0
-        first = start
-        while True:
-            step = min(chunk, budget - done)
-            code, n = kernel(
-                self._cell, self._g, self._qkey, self._qnode, self._qnext, self._heads,
-                self._bits, self._skey, self._snode, self._meta, self._cq, self._cf, gen,
-                first, goal, wp, self.corner_cutting, step,
-            )
-            first = -1
-            done += n
-            if code == CODE_SUCCESS:
-                cells, pts = _trace_entry(self._cell, start, goal, wp, *origin)
-                return SearchResult(Status.SUCCESS, cells, float(self._g[goal]), done, pts)
-            if code == CODE_NO_PATH:
-                if self._labels is None:  # the next query between regions: no search
-                    self._labels = self._make_labels()
-                return SearchResult(Status.NO_PATH, _NO_CELLS, math.inf, done)
-            if code == CODE_GROW:
-                self._grow_heap()
-                continue
-            if done >= budget:
-                return SearchResult(Status.MAX_ITERATIONS, _NO_CELLS, math.inf, done)
-            if time_limit_s is not None and time.perf_counter() - t0 > time_limit_s:
-                return SearchResult(Status.TIMEOUT, _NO_CELLS, math.inf, done)
-
+            while True:
+                step = min(chunk, budget - done)
+                code, n, cells, pts, cost = kernel(
+                    self._cell, self._g, self._qkey, self._qnode, self._qnext, self._heads,
+                    self._bits, self._skey, self._snode, self._meta, self._cq, self._cf, gen,
+                    first, goal, wp, self.corner_cutting, step, start, ox, oy, res,
+                )
+                first = -1
+                done += n
+                if code == CODE_SUCCESS:  # the kernel traced the path in the same call
+                    return Status.SUCCESS, cells, cost, done, pts
+                if code == CODE_NO_PATH:
+                    if self._labels is None:  # the next query between regions: no search
+                        self._labels = self._make_labels()
+                    return Status.NO_PATH, _NO_CELLS, math.inf, done, _NO_POINTS
+                if code == CODE_GROW:
+                    self._grow_heap()
+                    continue
+                if done >= budget:
+                    return Status.MAX_ITERATIONS, _NO_CELLS, math.inf, done, _NO_POINTS
+                if time_limit_s is not None and time.perf_counter() - t0 > time_limit_s:
+                    return Status.TIMEOUT, _NO_CELLS, math.inf, done, _NO_POINTS
 
     def closed_mask(self) -> np.ndarray:
         """The cells the last search closed (expanded), as an (H, W) bool array.
@@ -446,9 +451,9 @@ def _new_searcher(grid, corner_cutting: bool,  # type: ignore[no-untyped-def]
 
 
 # What a search calls for each heuristic: its kernel, or after warmup() numba's compiled
-# entry of it for the searcher's argument types (see _entry_point); the same for the trace.
+# entry of it for the searcher's argument types (see _entry_point).  The kernel traces the
+# path itself (kernel._trace), so a query makes one call into compiled code.
 _KERNEL_ENTRY: dict[str, Any] = {"euclidean": _astar_ring, "octile": _astar_radix}
-_trace_entry: Any = _trace
 
 
 def _entry_point(dispatcher: Any, args: tuple[Any, ...]) -> Any:
@@ -473,7 +478,6 @@ _WARM: set[str] = set()  # the heuristics whose kernel is compiled or loaded
 def warmup(heuristics: tuple[str, ...] = HEURISTICS) -> None:
     """Compile (or load from numba's on-disk cache) the A* kernels of ``heuristics`` (each
     has its own) on a tiny grid."""
-    global _trace_entry
     todo = [h for h in heuristics if h not in _WARM]
     if not todo:
         return
@@ -488,6 +492,5 @@ def warmup(heuristics: tuple[str, ...] = HEURISTICS) -> None:
     for heur in todo:
         _KERNEL_ENTRY[heur] = _entry_point(_KERNEL_ENTRY[heur], (
             s._cell, s._g, s._qkey, s._qnode, s._qnext, s._heads, s._bits, s._skey,
-            s._snode, s._meta, s._cq, s._cf, 2, 5, 7, s._wp, False, 1))
-    _trace_entry = _entry_point(_trace, (s._cell, 5, 7, s._wp, 0.0, 0.0, 1.0))
+            s._snode, s._meta, s._cq, s._cf, 2, 5, 7, s._wp, False, 1, 5, 0.0, 0.0, 1.0))
     _WARM.update(todo)

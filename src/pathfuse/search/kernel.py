@@ -135,6 +135,31 @@ def _spush(skey, snode, size, key, node):
     return size + 1
 
 
+@njit(cache=True, nogil=True)
+def _trace(cell, start, goal, wp, ox, oy, res):
+    """The path from start to goal: ``(cells, points)``, the (n, 2) unpadded ``(row, col)``
+    cells and their centres ``[x, y]`` for a grid of origin ``(ox, oy)`` and cell side
+    ``res`` (one call, so a query pays one dispatch for both)."""
+    offs = (1, -1, wp, -wp, wp + 1, wp - 1, -wp + 1, -wp - 1)  # a tuple: no np.array to compile
+    n = 1
+    p = goal
+    while p != start:
+        p -= offs[(cell[p] >> 1) & 15]
+        n += 1
+    out = np.empty((n, 2), dtype=np.int64)
+    pts = np.empty((n, 2))
+    p = goal
+    for i in range(n - 1, -1, -1):
+        r = p // wp
+        out[i, 0] = r - 1
+        out[i, 1] = p - r * wp - 1
+        pts[i, 0] = ox + (out[i, 1] + 0.5) * res
+        pts[i, 1] = oy + (out[i, 0] + 0.5) * res
+        if i > 0:
+            p -= offs[(cell[p] >> 1) & 15]
+    return out, pts
+
+
 # Long on purpose (~270 lines): the hot loop of every grid search, one function so
 # that numba keeps its state (the open list's heads, the current cell's word and its
 # neighbours') in locals; the pieces that stand alone are already helpers, and
@@ -154,7 +179,7 @@ def _make_kernel(use_ring: bool) -> Any:
     @njit(cache=True, nogil=True)
     def kernel(
         cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, cq, cf, gen,
-        start, goal, wp, corner_cutting, max_exp,
+        start, goal, wp, corner_cutting, max_exp, root, ox, oy, res,
     ):
         """Run A* until the goal is closed, the open list empties or ``max_exp`` expansions.
 
@@ -196,10 +221,15 @@ def _make_kernel(use_ring: bool) -> Any:
           (written out in the loop).
 
         ``meta`` = [radix: last key / ring: current bucket, free-list head, pool
-        slots used, pool entries, heap entries].  ``cq`` (uint64) and ``cf``
-        (float64), 8 entries each, hold the neighbours one expansion queues and
-        their ``f`` (the caller's, so that the kernel allocates nothing).  Returns
-        (code, expansions in this call).
+        slots used, pool entries, heap entries, ring: 1 when its buckets are all
+        empty (a query ended), else they are cleared when a query starts].  ``cq``
+        (uint64) and ``cf`` (float64), 8 entries each, hold the neighbours one
+        expansion queues and their ``f`` (the caller's, so that the search
+        allocates nothing).  Returns (code, expansions in this call, cells,
+        points, cost): on ``CODE_SUCCESS`` the path from ``root`` (the query's
+        start) to the goal as :func:`_trace` gives it for the grid origin
+        ``(ox, oy)`` and cell side ``res``, and ``g`` of the goal; else two
+        empty (0, 2) arrays and ``inf``.
         """
         s2 = 1.4142135623730951
         one = np.uint64(1)
@@ -223,10 +253,16 @@ def _make_kernel(use_ring: bool) -> Any:
             fh = np.int64(-1)  # typed int64, not a literal: one signature of _qpush and _spush
             used = np.int64(0)
             if use_ring:
-                for i in range(_RING_SIZE):
-                    heads[i] = -1
-                for i in range(_RING_SIZE // 64):
-                    bits[i] = 0
+                # a query that ended (goal closed, or region exhausted) left the ring empty
+                # (meta[5] = 1, see the end); a new searcher's buffers or a query stopped
+                # midway (budget, time) are cleared here, 16 KiB of writes a query no longer
+                # pays on a small map (issue 21)
+                if meta[5] != 1:
+                    for i in range(_RING_SIZE):
+                        heads[i] = -1
+                    for i in range(_RING_SIZE // 64):
+                        bits[i] = 0
+                meta[5] = 0
                 last = np.uint64(0)
                 cur = np.int64(f0 * _RING_SCALE)
                 size = 0
@@ -234,6 +270,8 @@ def _make_kernel(use_ring: bool) -> Any:
             else:
                 for i in range(65):
                     heads[i] = -1
+                meta[5] = 0  # the radix heap fills the ring's first buckets (one searcher
+                # runs both kernels): the next euclidean query clears the ring
                 last = k0
                 cur = np.int64(0)
                 fh, used = _qpush(qkey, qnode, qnext, heads, last, fh, used, last, start)
@@ -456,35 +494,24 @@ def _make_kernel(use_ring: bool) -> Any:
         meta[2] = used
         meta[3] = size
         meta[4] = ssize
-        return code, n_exp
+        if use_ring and (code == CODE_SUCCESS or code == CODE_NO_PATH):
+            # the query is over: empty the buckets still holding entries (their bits; a
+            # bucket's head and bit are set and cleared together), so the next query
+            # finds the ring empty without clearing all of it
+            for w in range(_RING_SIZE // 64):
+                word = bits[w]
+                while word != 0:
+                    heads[(w << 6) + _trailing_zeros(word)] = -1
+                    word &= word - one
+                bits[w] = 0
+            meta[5] = 1
+        if code == CODE_SUCCESS:  # the path, in the same call (no second dispatch)
+            cells, pts = _trace(cell, root, goal, wp, ox, oy, res)
+            return code, n_exp, cells, pts, gbuf[goal]
+        return code, n_exp, np.empty((0, 2), dtype=np.int64), np.empty((0, 2)), math.inf
 
     return kernel
 
 
 _astar_ring = _make_kernel(True)  # the euclidean heuristic's kernel
 _astar_radix = _make_kernel(False)  # the octile heuristic's kernel
-
-
-@njit(cache=True, nogil=True)
-def _trace(cell, start, goal, wp, ox, oy, res):
-    """The path from start to goal: ``(cells, points)``, the (n, 2) unpadded ``(row, col)``
-    cells and their centres ``[x, y]`` for a grid of origin ``(ox, oy)`` and cell side
-    ``res`` (one call, so a query pays one dispatch for both)."""
-    offs = (1, -1, wp, -wp, wp + 1, wp - 1, -wp + 1, -wp - 1)  # a tuple: no np.array to compile
-    n = 1
-    p = goal
-    while p != start:
-        p -= offs[(cell[p] >> 1) & 15]
-        n += 1
-    out = np.empty((n, 2), dtype=np.int64)
-    pts = np.empty((n, 2))
-    p = goal
-    for i in range(n - 1, -1, -1):
-        r = p // wp
-        out[i, 0] = r - 1
-        out[i, 1] = p - r * wp - 1
-        pts[i, 0] = ox + (out[i, 1] + 0.5) * res
-        pts[i, 1] = oy + (out[i, 0] + 0.5) * res
-        if i > 0:
-            p -= offs[(cell[p] >> 1) & 15]
-    return out, pts

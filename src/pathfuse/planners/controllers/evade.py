@@ -126,9 +126,13 @@ def evade_fan(cm, f, x, y, th, c0, c1, dpos, dvel, drad, tail_s, spread, enough_
             if abs(e) <= math.pi / EVADE_HEADINGS + 1e-9:
                 s += keep_bonus
         ex, ey = _end(f.dt_s, f.model_dt_s, seqs[i], x, y, th)
-        # the gap first (in steps of a millimetre), then the end's distance to the goal
-        key[i] = -math.floor(s * 1000.0) * 1e6 + min(math.hypot(ex - goal_x, ey - goal_y),
-                                                     1e5)
+        # the gap first (in steps of a millimetre), then the end's distance to the goal; a
+        # sequence into a wall (gap -inf) is clamped first: math.floor(-inf) in numba gives
+        # the least int64, whose negation overflows and ranked such a sequence best, so that
+        # the loop of Evader.choose stopped at it and no escape was ever taken where any
+        # heading of the fan met a wall (every trigger in four replays of the tuning family)
+        key[i] = -math.floor(max(s, -1e3) * 1000.0) * 1e6 + min(
+            math.hypot(ex - goal_x, ey - goal_y), 1e5)
         gaps[i] = g
         heads[i] = hd
     order[:] = np.argsort(key)

@@ -153,3 +153,21 @@ def test_fusion_with_evade_passes_a_head_on_disc_through_the_shield():
     # an independent check of the gap to the disc at every tick
     gaps = np.hypot(*(ep.positions[:, None, :] - ep.obstacle_positions).transpose(2, 0, 1))
     assert float((gaps - ep.obstacle_radii - 0.2).min()) > 0.0
+
+
+def test_the_trigger_counts_only_the_discs_marked():
+    """Ours (``evade_steady``): a disc not marked (seen to wander) does not set the escape off,
+    a marked one does; the fusion's switch is off by default."""
+    from pathfuse.planners.controllers.fusion import FusionParams
+
+    cm = _open()
+    f = _settings()
+    dpos, dvel, drad = _head_on()
+    stand = np.zeros((25, 2))
+    plan = stand.copy()
+    assert not Evader((9.0, 5.0)).choose(cm, f, 5.0, 5.0, 0.0, 0.0, 0.0, plan, dpos, dvel,
+                                         drad, None, np.array([False]))
+    assert np.array_equal(plan, stand)
+    assert Evader((9.0, 5.0)).choose(cm, f, 5.0, 5.0, 0.0, 0.0, 0.0, plan, dpos, dvel, drad,
+                                     None, np.array([True]))
+    assert FusionParams().evade_steady is False

@@ -182,19 +182,33 @@ class Evader:
 
     def choose(self, cm, f, x: float, y: float, th: float, c0: float, c1: float,
                nominal: np.ndarray, dpos: np.ndarray, dvel: np.ndarray,
-               drad: np.ndarray, passes: Any = None) -> bool:
+               drad: np.ndarray, passes: Any = None, trigger: Any = None) -> bool:
         """Replace ``nominal`` in place by an escape when the plan's predicted gap is below
         ``trigger_m`` and the escape gains ``gain_m``; True when it did.  ``passes(v, w)``
         (the shield's test: True when the shield lets the command through unchanged) must
-        accept an escape's first command: escapes the shield would hold back are skipped."""
+        accept an escape's first command: escapes the shield would hold back are skipped.
+        ``trigger`` (a boolean mask of the discs, ours: ``evade_steady``) limits the trigger
+        to the discs it marks (the discs seen steady; a wandering disc's constant-velocity
+        prediction does not show its contact in time); the escapes are still judged against
+        every disc."""
         if self.left > 0:
             self.left -= 1
         else:
             self.heading = math.nan
         if drad.shape[0] == 0:
             return False
-        g0 = min(sequence_gap(cm, f.dt_s, f.model_dt_s, nominal, x, y, th, dpos, dvel, drad,
-                              self.tail_s), self.enough_m)
+        if trigger is not None:
+            sel = np.flatnonzero(np.asarray(trigger, dtype=np.bool_)[:drad.shape[0]])
+            if sel.shape[0] == 0:
+                return False
+            g0 = min(sequence_gap(cm, f.dt_s, f.model_dt_s, nominal, x, y, th,
+                                  np.ascontiguousarray(dpos[sel]),
+                                  np.ascontiguousarray(dvel[sel]),
+                                  np.ascontiguousarray(drad[sel]), self.tail_s),
+                     self.enough_m)
+        else:
+            g0 = min(sequence_gap(cm, f.dt_s, f.model_dt_s, nominal, x, y, th, dpos, dvel,
+                                  drad, self.tail_s), self.enough_m)
         if g0 >= self.trigger_m:
             return False
         if self.spread > 0.0:

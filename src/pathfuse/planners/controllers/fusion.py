@@ -180,6 +180,11 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                     "the safest whose first command the shield passes unchanged (kept with "
                     "hysteresis) replaces it (planners/controllers/evade.py); off by "
                     "default: no gain measured (docs/results/dynamic.md)")
+    evade_steady: bool = param(
+        False, help="ours, with evade: only sensed discs seen steady (sensed for 1 s and "
+                    "keeping their velocity) set the escape off; the escapes are still judged "
+                    "against every disc (a wandering disc's constant-velocity prediction "
+                    "shows its contact too late to escape); false = every disc")
     walker_escape: bool = param(
         False, help="ours (diff-drive robot online, among_discs='mppi'): dwa's lane escape "
                     "(planners/controllers/dwa_escape.py) on the sequences' command: while "

@@ -9,7 +9,12 @@ import numpy as np
 import pytest
 
 from pathfuse.costmap import make_costmap
-from pathfuse.planners.controllers.evade import EVADE_HEADINGS, Evader, sequence_gap
+from pathfuse.planners.controllers.evade import (
+    EVADE_HEADINGS,
+    Evader,
+    evade_fan,
+    sequence_gap,
+)
 from pathfuse.planners.controllers.mppi_kernel import pack_mppi
 from pathfuse.sweep import unicycle_pose
 
@@ -108,6 +113,30 @@ def test_evader_leaves_the_lane_and_only_by_an_escape_the_shield_passes():
     assert np.array_equal(plan3, stand)
 
 
+def test_a_fan_heading_into_a_wall_does_not_block_the_escape():
+    """Regression (a bug until issue 17's walked-into round): a fan sequence into a wall has
+    the gap -inf, and numba's math.floor(-inf) negated overflowed, ranking it first; the
+    choice then stopped at it and took no escape."""
+    occ = np.zeros((20, 20), dtype=np.bool_)
+    occ[:, 7] = True                      # a wall at x = 3.5-4 m, behind the robot
+    cm = make_costmap(occ, 0.25, resolution_m=0.5)
+    f = _settings()
+    dpos, dvel, drad = _head_on()
+    stand = np.zeros((25, 2))
+    seqs = np.empty((EVADE_HEADINGS, 25, 2))
+    gaps = np.empty(EVADE_HEADINGS)
+    heads = np.empty(EVADE_HEADINGS)
+    order = np.empty(EVADE_HEADINGS, dtype=np.int64)
+    evade_fan(cm, f, 5.0, 5.0, 0.0, 0.0, 0.0, dpos, dvel, drad, 3.0, 0.2, 0.5, 9.0, 5.0,
+              math.nan, 0.1, seqs, gaps, heads, order)
+    assert (gaps == -math.inf).any()      # some headings meet the wall
+    assert gaps[order[0]] == gaps.max()   # the best gap is ranked first
+    ev = Evader((9.0, 5.0))
+    plan = stand.copy()
+    assert ev.choose(cm, f, 5.0, 5.0, 0.0, 0.0, 0.0, plan, dpos, dvel, drad)
+    assert sequence_gap(cm, 0.1, 0.1, plan, 5.0, 5.0, 0.0, dpos, dvel, drad, 2.0) >= 0.1
+
+
 def test_fusion_with_evade_passes_a_head_on_disc_through_the_shield():
     """The switch reaches the controller: with ``evade`` on, the fusion's diff-drive robot
     passes the shipped head-on scenario; every command went through the shield (its counts
@@ -124,3 +153,21 @@ def test_fusion_with_evade_passes_a_head_on_disc_through_the_shield():
     # an independent check of the gap to the disc at every tick
     gaps = np.hypot(*(ep.positions[:, None, :] - ep.obstacle_positions).transpose(2, 0, 1))
     assert float((gaps - ep.obstacle_radii - 0.2).min()) > 0.0
+
+
+def test_the_trigger_counts_only_the_discs_marked():
+    """Ours (``evade_steady``): a disc not marked (seen to wander) does not set the escape off,
+    a marked one does; the fusion's switch is off by default."""
+    from pathfuse.planners.controllers.fusion import FusionParams
+
+    cm = _open()
+    f = _settings()
+    dpos, dvel, drad = _head_on()
+    stand = np.zeros((25, 2))
+    plan = stand.copy()
+    assert not Evader((9.0, 5.0)).choose(cm, f, 5.0, 5.0, 0.0, 0.0, 0.0, plan, dpos, dvel,
+                                         drad, None, np.array([False]))
+    assert np.array_equal(plan, stand)
+    assert Evader((9.0, 5.0)).choose(cm, f, 5.0, 5.0, 0.0, 0.0, 0.0, plan, dpos, dvel, drad,
+                                     None, np.array([True]))
+    assert FusionParams().evade_steady is False

@@ -126,9 +126,13 @@ def evade_fan(cm, f, x, y, th, c0, c1, dpos, dvel, drad, tail_s, spread, enough_
             if abs(e) <= math.pi / EVADE_HEADINGS + 1e-9:
                 s += keep_bonus
         ex, ey = _end(f.dt_s, f.model_dt_s, seqs[i], x, y, th)
-        # the gap first (in steps of a millimetre), then the end's distance to the goal
-        key[i] = -math.floor(s * 1000.0) * 1e6 + min(math.hypot(ex - goal_x, ey - goal_y),
-                                                     1e5)
+        # the gap first (in steps of a millimetre), then the end's distance to the goal; a
+        # sequence into a wall (gap -inf) is clamped first: math.floor(-inf) in numba gives
+        # the least int64, whose negation overflows and ranked such a sequence best, so that
+        # the loop of Evader.choose stopped at it and no escape was ever taken where any
+        # heading of the fan met a wall (every trigger in four replays of the tuning family)
+        key[i] = -math.floor(max(s, -1e3) * 1000.0) * 1e6 + min(
+            math.hypot(ex - goal_x, ey - goal_y), 1e5)
         gaps[i] = g
         heads[i] = hd
     order[:] = np.argsort(key)
@@ -178,19 +182,33 @@ class Evader:
 
     def choose(self, cm, f, x: float, y: float, th: float, c0: float, c1: float,
                nominal: np.ndarray, dpos: np.ndarray, dvel: np.ndarray,
-               drad: np.ndarray, passes: Any = None) -> bool:
+               drad: np.ndarray, passes: Any = None, trigger: Any = None) -> bool:
         """Replace ``nominal`` in place by an escape when the plan's predicted gap is below
         ``trigger_m`` and the escape gains ``gain_m``; True when it did.  ``passes(v, w)``
         (the shield's test: True when the shield lets the command through unchanged) must
-        accept an escape's first command: escapes the shield would hold back are skipped."""
+        accept an escape's first command: escapes the shield would hold back are skipped.
+        ``trigger`` (a boolean mask of the discs, ours: ``evade_steady``) limits the trigger
+        to the discs it marks (the discs seen steady; a wandering disc's constant-velocity
+        prediction does not show its contact in time); the escapes are still judged against
+        every disc."""
         if self.left > 0:
             self.left -= 1
         else:
             self.heading = math.nan
         if drad.shape[0] == 0:
             return False
-        g0 = min(sequence_gap(cm, f.dt_s, f.model_dt_s, nominal, x, y, th, dpos, dvel, drad,
-                              self.tail_s), self.enough_m)
+        if trigger is not None:
+            sel = np.flatnonzero(np.asarray(trigger, dtype=np.bool_)[:drad.shape[0]])
+            if sel.shape[0] == 0:
+                return False
+            g0 = min(sequence_gap(cm, f.dt_s, f.model_dt_s, nominal, x, y, th,
+                                  np.ascontiguousarray(dpos[sel]),
+                                  np.ascontiguousarray(dvel[sel]),
+                                  np.ascontiguousarray(drad[sel]), self.tail_s),
+                     self.enough_m)
+        else:
+            g0 = min(sequence_gap(cm, f.dt_s, f.model_dt_s, nominal, x, y, th, dpos, dvel,
+                                  drad, self.tail_s), self.enough_m)
         if g0 >= self.trigger_m:
             return False
         if self.spread > 0.0:

@@ -180,6 +180,11 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                     "the safest whose first command the shield passes unchanged (kept with "
                     "hysteresis) replaces it (planners/controllers/evade.py); off by "
                     "default: no gain measured (docs/results/dynamic.md)")
+    evade_steady: bool = param(
+        False, help="ours, with evade: only sensed discs seen steady (sensed for 1 s and "
+                    "keeping their velocity) set the escape off; the escapes are still judged "
+                    "against every disc (a wandering disc's constant-velocity prediction "
+                    "shows its contact too late to escape); false = every disc")
     walker_escape: bool = param(
         False, help="ours (diff-drive robot online, among_discs='mppi'): dwa's lane escape "
                     "(planners/controllers/dwa_escape.py) on the sequences' command: while "
@@ -199,6 +204,13 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                    "turned by the window and taken elsewhere by the recovery, may never pass "
                    "the escape's target, and the escape drew it back there, its progress "
                    "along the path frozen; false = off")
+    flee: bool = param(
+        False, help="ours (diff-drive robot online, velocity space, among discs): while a "
+                    "sensed disc is within 1 m, the reachable window's command whose rollout "
+                    "(held 1 s, then a stop) keeps the largest gap to the discs predicted at "
+                    "constant velocity and grown by 0.3 m/s replaces it, if it gains 0.05 m "
+                    "and the shield would pass it unchanged (planners/controllers/flee.py); "
+                    "false = off")
     replan_new: bool = param(
         True, help="ours (diff-drive robot online, velocity space): replan around a disc as "
                    "soon as it is first sensed, not up to replan_period_s later; false = off")
@@ -263,6 +275,8 @@ class FusionController(FieldController):
         self.escapes_given_up = 0
         """Escapes of Algorithm 2 given up online (``escape_limit``)."""
         self.replans = 0
+        self.flees = 0
+        """Ticks whose command came from ``flee``."""
         self._replan_every = 0
         if self._window is not None and p.replan_period_s > 0:
             self._replan_every = max(1, int(round(p.replan_period_s / self._window.f.dt_s)))
@@ -289,6 +303,8 @@ class FusionController(FieldController):
                 self._window.passes = self._shield_passes(obs)
             a = self._window.choose(obs, self._streamline(obs), self.pts, self.cum,
                                     int(self.state[S_K]))
+            if self.params.flee and len(obs.obstacles):
+                a = self._flee(obs, a)
         if not self.problem.robot.shield:  # type: ignore[union-attr]
             return a
         return self._shielded(obs, a)
@@ -320,6 +336,28 @@ class FusionController(FieldController):
             return bool(code == ASKED)
 
         return passes
+
+    def _flee(self, obs: Any, a: np.ndarray) -> np.ndarray:
+        """Ours (``flee``): the controller's slow command next to a disc replaced by the
+        window's command that keeps the largest predicted gap, if the shield passes it
+        unchanged (:mod:`pathfuse.planners.controllers.flee`)."""
+        from pathfuse.planners.controllers.flee import flee_command
+
+        rb = self.problem.robot
+        assert rb is not None
+        sens = obs.obstacles
+        passes = self._shield_passes(obs)
+        lim = (float(rb.min_speed_mps), float(rb.max_speed_mps), float(rb.max_accel_mps2),
+               float(rb.max_yaw_rate_radps), float(rb.max_yaw_accel_radps2))
+        v, w, done = flee_command(
+            self._window.costmap, float(obs.position[0]), float(obs.position[1]),
+            float(obs.heading), float(obs.command[0]), float(obs.command[1]), float(a[0]),
+            float(a[1]), float(self.dt), lim,  # type: ignore[arg-type]
+            _plain(sens.positions), _plain(sens.velocities), _plain(sens.radii), passes)
+        if not done:
+            return a
+        self.flees += 1
+        return np.array([v, w])
 
     def _set_path(self, pts: np.ndarray) -> None:
         """The global path the A* points come from, ending at the goal."""

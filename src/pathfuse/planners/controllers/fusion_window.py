@@ -242,6 +242,8 @@ class ForceWindow:
             from pathfuse.planners.controllers.evade import Evader
 
             self.evader = Evader(problem.goal, dt=float(dt))
+        self.evade_steady = bool(getattr(sp, "evade_steady", False))
+        """Ours (the fusion's ``evade_steady``): only discs seen steady set ``evade`` off."""
         self.walker_escape = among_discs == "mppi" and bool(getattr(sp, "walker_escape",
                                                                     False))
         """Ours (the fusion's ``walker_escape``): ``dwa``'s lane escape on the sequences'
@@ -401,7 +403,7 @@ class ForceWindow:
                            self._steady)
         if self.evader is not None and self.evader.choose(
                 m.costmap, m.f, x, y, th, float(cmd[0]), float(cmd[1]), m.nominal, dpos, dvel,
-                drad, self.passes):
+                drad, self.passes, self._steady if self.evade_steady else None):
             # ours (evade, :mod:`pathfuse.planners.controllers.evade`): the plan stops in a
             # disc's predicted sweep; an escape out of every sensed disc's sweep instead
             a0, a1 = float(m.nominal[0, 0]), float(m.nominal[0, 1])

@@ -54,11 +54,6 @@ ESCAPE_DWELL_S = 1.5
 HOLD_BONUS = 0.5
 """Taken off the cost of the sequence towards the heading escaped towards last tick."""
 CONTACT_COST = 1000.0
-ROOM_COST = 500.0
-"""Added (ours, the fusion's ``walker_escape_room_s``) to a sequence whose end, were the robot
-to stand there, a steady disc would touch within the room time after the sequence ends (plus
-10 per second of that time left): below a clean end, above any sequence touched while it
-moves."""
 PASSIVE_COST = 20.0
 """Added to a sequence that, while it moves, comes closer to a disc than the disc can travel
 while the robot stops (the shield would slow it there), plus 10 per metre of the shortfall."""
@@ -126,17 +121,12 @@ def _turn_step(p0, p1, err, h, vmin, vmax, amax, wmax, alpha, arc):
 
 @njit(cache=True)
 def escape_rollout(cm, f, clear, x, y, th, c0, c1, turn, heading, hold_v, hold_w, n, pts, cum,
-                   k, jg, bb, dpos, dvel, drad, dwell_s, steady, out, room_s,
-                   room_trust):
+                   k, jg, bb, dpos, dvel, drad, dwell_s, steady, out):
     """Roll one sequence out over ``n`` steps of ``f.dt_s``: ``dwa``'s sample ``(hold_v,
     hold_w)`` held (``turn`` 0) or turn-then-go towards ``heading`` (``turn`` 1: speeding up
     as the heading comes round; 2: at full speed on an arc), the robot
     standing once the static map (``clear``) would be touched.  ``out = [cost, first contact
-    time (inf: none), v, w of the first step, static stop (1: yes)]``.  ``room_s`` > 0
-    (ours, the fusion's ``walker_escape_room_s``): :data:`ROOM_COST` is added where a disc of
-    ``room_trust`` (every disc when empty; those the escape trusts, a disc sensed too briefly
-    to be steady included), predicted on at constant velocity, would touch the robot standing
-    at the sequence's end within ``room_s`` after it ends."""
+    time (inf: none), v, w of the first step, static stop (1: yes)]``."""
     h = f.dt_s
     radius = cm.radius_m
     slack = MARGIN_FRAC * cm.res_m
@@ -223,18 +213,13 @@ def escape_rollout(cm, f, clear, x, y, th, c0, c1, turn, heading, hold_v, hold_w
         cost += PASSIVE_COST + 10.0 * min(-pmin, 10.0)
     if tc < np.inf:
         cost += CONTACT_COST + 100.0 * (tend - tc)
-    elif room_s > 0.0:
-        later = standing_contact_s(px, py, radius, room_s, dpos + dvel * tend, dvel, drad,
-                                   room_trust)
-        if later < np.inf:
-            cost += ROOM_COST + 10.0 * (room_s - later)
     out[0] = cost
     out[1] = tc
 
 
 @njit(cache=True)
 def escape_command(cm, f, horizon_s, x, y, th, c0, c1, a0, a1, pts, cum, k, dpos, dvel, drad,
-                   steady, trust, last_heading, hold_bonus=HOLD_BONUS, room_s=0.0):
+                   steady, trust, last_heading, hold_bonus=HOLD_BONUS):
     """The lane escape (see the module docstring) for ``dwa``'s chosen command ``(a0, a1)``:
     ``(v, w, heading)``, the first step of the best turn-then-go sequence and the heading it
     turns to, when it replaces ``(a0, a1)``; ``(a0, a1, nan)`` otherwise.  ``last_heading`` is
@@ -242,9 +227,7 @@ def escape_command(cm, f, horizon_s, x, y, th, c0, c1, a0, a1, pts, cum, k, dpos
     the robot standing sets the escape off (empty: every disc).  ``f`` is ``dwa``'s
     :class:`~pathfuse.planners.controllers.dwa_kernel.DwaSettings` (its dwell critic at least
     :data:`ESCAPE_DWELL_S` long); ``hold_bonus`` is taken off the cost of the sequence
-    towards ``last_heading`` (``dwa``: :data:`HOLD_BONUS`); ``room_s`` > 0 charges
-    :data:`ROOM_COST` to sequences whose end a steady disc would walk into within ``room_s``
-    after they end (ours, the fusion's ``walker_escape_room_s``; ``dwa``: 0, off)."""
+    towards ``last_heading`` (``dwa``: :data:`HOLD_BONUS`)."""
     nan = math.nan
     if drad.shape[0] == 0:
         return a0, a1, nan
@@ -259,7 +242,7 @@ def escape_command(cm, f, horizon_s, x, y, th, c0, c1, a0, a1, pts, cum, k, dpos
     dwell_s = max(f.dwell_s, ESCAPE_DWELL_S)
     out = np.zeros(5)
     escape_rollout(cm, f, clear, x, y, th, c0, c1, 0, 0.0, a0, a1, n, pts, cum, k, jg, bb,
-                   dpos, dvel, drad, dwell_s, steady, out, room_s, trust)
+                   dpos, dvel, drad, dwell_s, steady, out)
     escaping = last_heading == last_heading
     if out[1] == np.inf and not escaping:
         return a0, a1, nan  # dwa's own choice is not touched within the horizon
@@ -277,7 +260,7 @@ def escape_command(cm, f, horizon_s, x, y, th, c0, c1, a0, a1, pts, cum, k, dpos
         else:
             break
         escape_rollout(cm, f, clear, x, y, th, c0, c1, 1 + i % 2, hd, 0.0, 0.0, n, pts, cum,
-                       k, jg, bb, dpos, dvel, drad, dwell_s, steady, out, room_s, trust)
+                       k, jg, bb, dpos, dvel, drad, dwell_s, steady, out)
         if out[1] < np.inf:
             continue  # touched too: not an escape
         c = out[0]

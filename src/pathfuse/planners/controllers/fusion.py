@@ -199,22 +199,9 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
              "which the escape's heading swung and east_three_lanes seed 0 collided)")
     walker_escape_s: float = param(
         4.0, gt=0, le=30, unit="s",
-        help="ours, with walker_escape (or walker_window): the escape's horizon: it is set "
-             "off while the robot standing would be touched within this time, and its "
+        help="ours, with walker_escape: the escape's horizon: it is set off while "
+             "the robot standing would be touched within this time, and its "
              "sequences are rolled out over it (dwa's lane_escape_s is 4 s)")
-    walker_window: bool = param(
-        False, help="ours (diff-drive robot online, among_discs='mppi'): while the robot "
-                    "standing would be touched within dwa's lane_escape_s (4 s) by a sensed "
-                    "disc not seen to wander, the window's dwa choice (dwa's critics, passing "
-                    "sides) with dwa's lane escape replaces MPPI's sequences, as dwa drives "
-                    "among walkers; the shield still checks it; false = off")
-    walker_escape_room_s: float = param(
-        0.0, ge=0, le=60, unit="s",
-        help="ours, with walker_escape: a sequence whose end a steady sensed disc, predicted "
-             "on at constant velocity, would walk into within this time after the sequence "
-             "ends (the robot standing there) is charged 500 (below a clean end, above a "
-             "sequence touched while it moves): the escape keeps room to stand outside the "
-             "lanes rather than fleeing along one ahead of a faster walker; 0 = off")
     escape_limit: bool = param(
         True, help="ours (diff-drive robot online, velocity space): Algorithm 2's escape is "
                    "given up after 2 x stall_steps moves that have not reached its target, "

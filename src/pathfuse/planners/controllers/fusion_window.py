@@ -250,14 +250,8 @@ class ForceWindow:
         command (:func:`~pathfuse.planners.controllers.dwa_escape.escape_command`)."""
         self.walker_escape_s = float(getattr(sp, "walker_escape_s", p.lane_escape_s))
         self.walker_escape_hold = float(getattr(sp, "walker_escape_hold", 5.0))
-        self.walker_escape_room_s = float(getattr(sp, "walker_escape_room_s", 0.0))
         self.walker_escapes = 0
         """Ticks whose command the walker escape replaced."""
-        self.walker_window = among_discs == "mppi" and bool(getattr(sp, "walker_window", False))
-        """Ours (the fusion's ``walker_window``): ``dwa``'s choice and lane escape instead of
-        the sequences while the robot standing would be walked into."""
-        self.walker_window_ticks = 0
-        """Ticks chosen by ``walker_window``."""
         self._escape_heading = math.nan
 
     def relax(self, seconds: float) -> None:
@@ -349,12 +343,9 @@ class ForceWindow:
         among = drad.shape[0] > 0
         if abs(err) > self.rotate_rad and not among:
             return self._rotate(err)
-        handover = self.walker_window and drad.shape[0] > 0 and self._standing_touched(
-            obs, x, y, dpos, dvel, drad)
-        if self.among_discs == "mppi" and drad.shape[0] > 0 and not handover:
+        if self.among_discs == "mppi" and drad.shape[0] > 0:
             return self._sequences(obs, path, kk, pts, cum, k, dpos, dvel, drad)
-        if not handover:
-            self._escape_heading = math.nan  # the walker escape's hysteresis ends
+        self._escape_heading = math.nan  # the walker escape's hysteresis ends with the discs
         f = self.f_relaxed if self.ticks <= self.relaxed_until else self.f
         # the keep critic's reference: the gap the A* path keeps ahead (the local path is
         # the field's streamline, which may graze)
@@ -367,12 +358,6 @@ class ForceWindow:
         a0, a1, _, _ = dwa_choose(self.costmap, f, tick, x, y,
                                   float(obs.heading), float(cmd[0]), float(cmd[1]), path, pcum,
                                   kk, dpos, dvel, drad, self.sides.sides(ids), chosen)
-        if handover:
-            # ours (walker_window): as dwa, its lane escape on its own choice
-            self.walker_window_ticks += 1
-            self._last_seq = -2  # the sequences restart from the present command
-            a0, a1 = self._walker_escape(obs, x, y, th, float(a0), float(a1), pts, cum, k,
-                                         dpos, dvel, drad)
         if n:
             self.sides.update(ids, chosen, dpos, (x, y), route, drad,
                               self.problem.robot_radius_m)
@@ -427,17 +412,6 @@ class ForceWindow:
                                          dpos, dvel, drad)
         return np.array([a0, a1])
 
-    def _standing_touched(self, obs: Any, x: float, y: float, dpos: np.ndarray,
-                          dvel: np.ndarray, drad: np.ndarray) -> bool:
-        """Ours (``walker_window``): a disc not seen to wander, predicted at constant
-        velocity, touches the robot standing here within ``dwa``'s ``lane_escape_s``."""
-        from pathfuse.planners.controllers.dwa_escape import standing_contact_s
-
-        trust = self.steady.trusted(disc_ids(obs, drad.shape[0]))
-        return bool(standing_contact_s(x, y, float(self.costmap.radius_m),
-                                       self.walker_escape_s, dpos, dvel, drad,
-                                       trust) < math.inf)
-
     def _walker_escape(self, obs: Any, x: float, y: float, th: float, a0: float, a1: float,
                        pts: np.ndarray, cum: np.ndarray, k: int, dpos: np.ndarray,
                        dvel: np.ndarray, drad: np.ndarray) -> tuple[float, float]:
@@ -457,7 +431,7 @@ class ForceWindow:
         v, w, hd = escape_command(self.costmap, self.f, self.walker_escape_s, x, y, th,
                                   float(cmd[0]), float(cmd[1]), a0, a1, pts, cum, kk, dpos,
                                   dvel, drad, self._steady, trust, self._escape_heading,
-                                  self.walker_escape_hold, self.walker_escape_room_s)
+                                  self.walker_escape_hold)
         self._escape_heading = hd
         if hd == hd:
             self.walker_escapes += 1

@@ -71,12 +71,17 @@ def layers(g: Any) -> dict[str, Any]:
         wp = s._wp
         s._gen += 2
         start = (sr + 1) * wp + sc + 1
-        args: tuple[Any, ...] = (
-            s._cell, s._g, s._qkey, s._qnode, s._qnext, s._heads, s._bits, s._skey,
-            s._snode, s._meta, s._cq, s._cf, s._gen, start, (gr + 1) * wp + gc + 1, wp,
-            False, s.free_count)
-        if s._meta.size >= 6:  # the kernel that traces the path itself
-            args += (start, 0.0, 0.0, 1.0)
+        goal = (gr + 1) * wp + gc + 1
+        args: tuple[Any, ...]
+        if hasattr(s, "_u64"):  # the buffers packed by dtype
+            args = (s._cell, s._f8, s._u64, s._i32, s._meta, s._gen, start, goal, wp, False,
+                    s.free_count, start, 0.0, 0.0, 1.0)
+        else:
+            args = (s._cell, s._g, s._qkey, s._qnode, s._qnext, s._heads, s._bits, s._skey,
+                    s._snode, s._meta, s._cq, s._cf, s._gen, start, goal, wp, False,
+                    s.free_count)
+            if s._meta.size >= 6:  # the kernel that traces the path itself
+                args += (start, 0.0, 0.0, 1.0)
         return int(A._KERNEL_ENTRY["euclidean"](*args)[1])
 
     return {

@@ -394,8 +394,8 @@ def test_buffer_reuse_generation_wraparound_and_heap_growth(heuristic):
     reused = AStarSearcher(occ)
     reused._gen = astar_mod._STAMP_LIMIT - 6  # force the stamp reset inside this run
     tiny = AStarSearcher(occ)
-    for name in ("_qkey", "_qnode", "_qnext", "_skey", "_snode"):  # 16 entries: must grow
-        setattr(tiny, name, getattr(tiny, name)[:16].copy())
+    tiny._pack(16, None)  # an open list of 16 entries: must grow
+    assert tiny._qkey.shape[0] == tiny._snode.shape[0] == 16
     for (s, g), ref in zip(pairs, fresh, strict=True):
         for searcher in (reused, tiny):
             r = searcher.search(s, g, heuristic=heuristic)

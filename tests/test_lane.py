@@ -247,3 +247,30 @@ def test_plan_checks_bad_input_after_warm_paths(start, error, words):
         pathfuse.plan(g, (0.5, 0.5), (3.5, 2.5), budget=5)
     with pytest.raises(ConfigError, match="clearance_m"):
         pathfuse.plan(g, (0.5, 0.5), (3.5, 2.5), clearance_m=float("nan"))
+
+
+def test_found_path_result_is_a_plan_result():
+    import copy
+    import dataclasses
+    import pickle
+
+    from pathfuse.planners.globals.astar import found_message
+
+    g = GridMap.from_rows(["......", "..#...", "..#...", "......"], resolution=0.5)
+    r = pathfuse.plan(g, (0.25, 0.25), (2.75, 1.75))
+    assert isinstance(r, pathfuse.PlanResult) and r
+    assert "message" not in r.__dict__  # written on first read
+    text = found_message(len(r.info["cells"]), r.length, r.expansions)
+    assert r.message == text and r.__dict__["message"] == text
+    assert repr(r).startswith("PlanResult(status=<Status.SUCCESS")
+    assert dataclasses.asdict(r)["message"] == text
+    assert r.to_dict()["message"] == text
+    fresh = pathfuse.plan(g, (0.25, 0.25), (2.75, 1.75))
+    for back in (pickle.loads(pickle.dumps(fresh)), copy.copy(fresh),
+                 dataclasses.replace(fresh, planner="other")):
+        assert isinstance(back, pathfuse.PlanResult) and back.message == text
+        assert np.array_equal(back.path, r.path) and back.length == r.length
+    assert type(pickle.loads(pickle.dumps(fresh))) is pathfuse.PlanResult
+    assert dataclasses.replace(fresh, planner="other").planner == "other"
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fresh.message = "x"  # type: ignore[misc]

@@ -28,7 +28,7 @@ from pathfuse.planners.globals.builtin import _astar as _builtin_astar
 from pathfuse.planners.globals.builtin import run_global
 from pathfuse.planners.registry import GLOBAL_PLANNERS, PlannerSpec, make_params
 from pathfuse.problem import _DEFAULT_BUDGET, Problem
-from pathfuse.result import Budget, ConfigError, PlanResult, Status, path_length
+from pathfuse.result import Budget, ConfigError, PlanResult, Status, _FoundPath, path_length
 from pathfuse.search.astar import HEURISTICS, SearchResult, get_searcher
 from pathfuse.validate import short as _shown
 
@@ -245,29 +245,30 @@ def _lane(name: str, grid: GridMap, start: tuple[float, float], goal: tuple[floa
     info = PlanInfo(cells=cells, cost_cells=length / res_m, heuristic=heuristic,
                     corner_cutting=cut)
     info._bound = (grid, points, 0.0)  # bind()'s body (a point robot)
-    # found_message's text, written out
-    return PlanResult._made(Status.SUCCESS, points, length, elapsed + 0.0, name,
-                            expansions, 0, f"path through {len(cells)} cells, "
-                            f"{length:.6g} m, {expansions} expansions", info)
+    # the message (found_message's text) is written when first read
+    return _FoundPath._made(Status.SUCCESS, points, length, elapsed + 0.0, name, expansions,
+                            0, None, info)
 
 
 #: The plans that took the lane in :func:`solve`, by ``id`` of their parameters: the
 #: parameters (so that a new object at a freed ``id`` is not taken for them), the spec,
-#: the heuristic, the corner rule and :func:`warm`'s key (see :func:`quick_plan`).
-_QUICK: dict[int, tuple[Any, PlannerSpec, str, bool, tuple[Any, ...]]] = {}
+#: the heuristic, the corner rule, :func:`warm`'s key and the global planner ``astar``'s
+#: registry entry, the built-in's (see :func:`quick_plan`).
+_QUICK: dict[int, tuple[Any, PlannerSpec, str, bool, tuple[Any, ...], Any]] = {}
 
 
 def _remember(spec: PlannerSpec, params: Any) -> None:
     """Note that ``solve(spec, problem, params)`` took the lane (it warmed the kernels and
-    checked the parameters' heuristic), for :func:`quick_plan`."""
-    if id(params) not in _QUICK:
-        if len(_QUICK) >= 256:
-            _QUICK.clear()
-        heuristic = getattr(params, "heuristic", "euclidean")
-        _QUICK[id(params)] = (params, spec, heuristic,
-                              bool(getattr(params, "corner_cutting", False)),
-                              (spec.name, "astar", False, False, False,
-                               getattr(params, "heuristic", None)))
+    checked the parameters' heuristic) with the global planner ``astar`` registered now,
+    for :func:`quick_plan` (a later plan that takes the lane in ``solve`` notes it again:
+    a plug-in may have come and gone)."""
+    if len(_QUICK) >= 256 and id(params) not in _QUICK:
+        _QUICK.clear()
+    _QUICK[id(params)] = (params, spec, getattr(params, "heuristic", "euclidean"),
+                          bool(getattr(params, "corner_cutting", False)),
+                          (spec.name, "astar", False, False, False,
+                           getattr(params, "heuristic", None)),
+                          GLOBAL_PLANNERS.get("astar"))
 
 
 def quick_plan(spec: PlannerSpec, params: Any, grid: object, start: object, goal: object,
@@ -287,26 +288,30 @@ def quick_plan(spec: PlannerSpec, params: Any, grid: object, start: object, goal
     equal to the layers'."""
     hit = _QUICK.get(id(params))
     if hit is None or hit[0] is not params or hit[1] is not spec or not _LANE or \
-            hit[4] not in _WARM or type(grid) is not GridMap:
+            hit[4] not in _WARM or type(grid) is not GridMap or \
+            GLOBAL_PLANNERS.get("astar") is not hit[5]:  # a plug-in registered since
         return None
-    if not (type(start) is tuple and len(start) == 2 and type(start[0]) is float and
-            type(start[1]) is float and math.isfinite(start[0]) and
-            math.isfinite(start[1]) and type(goal) is tuple and len(goal) == 2 and
-            type(goal[0]) is float and type(goal[1]) is float and
-            math.isfinite(goal[0]) and math.isfinite(goal[1])):
+    if type(start) is not tuple or len(start) != 2 or type(goal) is not tuple or \
+            len(goal) != 2:
+        return None
+    sx, sy = start
+    gx, gy = goal
+    if type(sx) is not float or type(sy) is not float or type(gx) is not float or \
+            type(gy) is not float:
         return None
     if budget is None:
         budget = _DEFAULT_BUDGET
     elif type(budget) is not Budget:
         return None
-    gs = GLOBAL_PLANNERS.get("astar")
-    if gs is None or gs.func is not _builtin_astar or gs.plugin is not None:
-        return None
     ox, oy = grid.origin
     res = grid.resolution
-    # Problem.create's cells and failure()'s first test (in the map, free, a point robot)
-    sr, sc = math.floor((start[1] - oy) / res), math.floor((start[0] - ox) / res)
-    gr, gc = math.floor((goal[1] - oy) / res), math.floor((goal[0] - ox) / res)
+    # Problem.create's cells (floor raises on a NaN or an infinite coordinate, which
+    # Problem.create rejects) and failure()'s first test (in the map, free, a point robot)
+    try:
+        sr, sc = math.floor((sy - oy) / res), math.floor((sx - ox) / res)
+        gr, gc = math.floor((gy - oy) / res), math.floor((gx - ox) / res)
+    except (ValueError, OverflowError):
+        return None
     occ = grid.occupied
     h, w = occ.shape
     if not (0 <= sr < h and 0 <= sc < w and 0 <= gr < h and 0 <= gc < w) or \

@@ -210,31 +210,44 @@ class AStarSearcher(_Regions):
         np.multiply(occ, _BLOCKED, out=cell[1:-1, 1:-1], dtype=np.uint32)  # 3x a mask
         self._cell = cell.ravel()  # blocked / stamp and move: see kernel._make_kernel
         n = self._cell.size
-        self._g = np.empty(n, dtype=np.float64)
-        cap = int(min(max(1024, n // 4), 1 << 20))
-        self._qkey = np.empty(cap, dtype=np.uint64)
-        self._qnode = np.empty(cap, dtype=np.int32)
-        self._qnext = np.empty(cap, dtype=np.int32)
-        self._skey = np.empty(cap, dtype=np.uint64)
-        self._snode = np.empty(cap, dtype=np.int32)
-        self._heads = np.empty(_RING_SIZE, dtype=np.int32)
-        self._bits = np.empty(_RING_SIZE // 64, dtype=np.uint64)
+        # g and the kernel's scratch (one expansion's queued neighbours' f), in one array
+        self._f8 = np.empty(n + 8, dtype=np.float64)
+        self._g = self._f8[:n]
         self._meta = np.zeros(6, dtype=np.int64)  # see kernel._make_kernel
-        self._cq = np.empty(8, dtype=np.uint64)  # the kernel's scratch: one expansion's
-        self._cf = np.empty(8)  # queued neighbours and their f
+        self._pack(int(min(max(1024, n // 4), 1 << 20)), None)
         self._gen = 0
         self._closed_gen = -1  # stamp of the cells the last search closed (-1: none)
         self.free_count = int(occ.size - np.count_nonzero(occ))
         self._init_labels(occ, labels)
         self.lock = threading.Lock()
 
+    def _pack(self, cap: int, old: dict[str, np.ndarray] | None) -> None:
+        """The open list's buffers for a pool and heap of ``cap`` entries, packed by dtype
+        in two arrays that the kernel takes apart (5 arrays to unbox per call, not 12:
+        issue 21): ``_u64`` = qkey | skey | bits | cq (the scratch of one expansion's
+        queued neighbours) and ``_i32`` = heads | qnode | qnext | snode, each part also
+        kept as a view under its own name.  With ``old``, its entries are copied (they
+        keep their indices; the ring's heads and bits too, a search paused midway resumes
+        on them)."""
+        nb = _RING_SIZE // 64
+        u64 = np.empty(2 * cap + nb + 8, dtype=np.uint64)
+        i32 = np.empty(_RING_SIZE + 3 * cap, dtype=np.int32)
+        self._qkey, self._skey = u64[:cap], u64[cap:2 * cap]
+        self._bits, self._cq = u64[2 * cap:2 * cap + nb], u64[2 * cap + nb:]
+        self._heads = i32[:_RING_SIZE]
+        self._qnode = i32[_RING_SIZE:_RING_SIZE + cap]
+        self._qnext = i32[_RING_SIZE + cap:_RING_SIZE + 2 * cap]
+        self._snode = i32[_RING_SIZE + 2 * cap:]
+        self._cf = self._f8[self._g.shape[0]:]
+        if old is not None:
+            for name, src in old.items():
+                getattr(self, name)[:src.shape[0]] = src
+        self._u64, self._i32 = u64, i32
+
     def _grow_heap(self) -> None:
         """Double the open-list pool and heap (entries keep their indices)."""
-        for name in ("_qkey", "_qnode", "_qnext", "_skey", "_snode"):
-            old = getattr(self, name)
-            new = np.empty(2 * old.shape[0], dtype=old.dtype)
-            new[: old.shape[0]] = old
-            setattr(self, name, new)
+        self._pack(2 * self._qkey.shape[0], {name: getattr(self, name) for name in (
+            "_qkey", "_skey", "_qnode", "_qnext", "_snode", "_heads", "_bits")})
 
     def search(
         self,
@@ -327,9 +340,8 @@ class AStarSearcher(_Regions):
             while True:
                 step = min(chunk, budget - done)
                 code, n, cells, pts, cost = kernel(
-                    self._cell, self._g, self._qkey, self._qnode, self._qnext, self._heads,
-                    self._bits, self._skey, self._snode, self._meta, self._cq, self._cf, gen,
-                    first, goal, wp, self.corner_cutting, step, start, ox, oy, res,
+                    self._cell, self._f8, self._u64, self._i32, self._meta, gen, first, goal,
+                    wp, self.corner_cutting, step, start, ox, oy, res,
                 )
                 first = -1
                 done += n
@@ -409,6 +421,30 @@ _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _CACHE_LOCK = threading.Lock()
 
 
+def _dead() -> None:
+    return None
+
+
+#: The map of the last :func:`get_searcher` call (weakly) and its searchers: the look-up
+#: without :class:`weakref.WeakKeyDictionary`'s call (issue 21: a query on a small map
+#: pays for every layer); forgotten when the map goes.
+_LAST: tuple[Any, dict[bool, AStarSearcher] | None] = (_dead, None)
+
+
+def _remember(grid: Any, per_map: dict[bool, AStarSearcher]) -> None:
+    global _LAST
+
+    def forget(ref: Any) -> None:
+        global _LAST
+        if _LAST[0] is ref:
+            _LAST = (_dead, None)
+
+    try:
+        _LAST = (weakref.ref(grid, forget), per_map)
+    except TypeError:  # not weakly referable: the WeakKeyDictionary would have refused it
+        pass
+
+
 def get_searcher(grid, corner_cutting: bool = False) -> AStarSearcher:
     """The cached :class:`AStarSearcher` of ``grid`` (a GridMap) for a corner rule.
 
@@ -418,7 +454,13 @@ def get_searcher(grid, corner_cutting: bool = False) -> AStarSearcher:
     returned (its buffers are not cached).
     """
     key = bool(corner_cutting)
-    per_map = _CACHE.get(grid)  # a read needs no lock (the GIL); adding a map takes it
+    last = _LAST  # one read: the pair is replaced whole
+    if last[0]() is grid:  # the map of the last look-up (a loop of queries on one map)
+        per_map = last[1]
+    else:
+        per_map = _CACHE.get(grid)  # a read needs no lock (the GIL); adding a map takes it
+        if per_map is not None:
+            _remember(grid, per_map)
     searcher = per_map.get(key) if per_map is not None else None
     if searcher is not None:
         return _new_searcher(grid, key, searcher._labels) if searcher.lock.locked() \
@@ -429,6 +471,7 @@ def get_searcher(grid, corner_cutting: bool = False) -> AStarSearcher:
             per_map = {}
             _CACHE[grid] = per_map
         searcher = per_map.get(key)
+    _remember(grid, per_map)
     if searcher is None:
         searcher = _new_searcher(grid, key, None)
         with _CACHE_LOCK:
@@ -491,6 +534,6 @@ def warmup(heuristics: tuple[str, ...] = HEURISTICS) -> None:
     # the arguments of a search (the types are all that matters; nothing is called)
     for heur in todo:
         _KERNEL_ENTRY[heur] = _entry_point(_KERNEL_ENTRY[heur], (
-            s._cell, s._g, s._qkey, s._qnode, s._qnext, s._heads, s._bits, s._skey,
-            s._snode, s._meta, s._cq, s._cf, 2, 5, 7, s._wp, False, 1, 5, 0.0, 0.0, 1.0))
+            s._cell, s._f8, s._u64, s._i32, s._meta, 2, 5, 7, s._wp, False, 1, 5, 0.0, 0.0,
+            1.0))
     _WARM.update(todo)

@@ -178,8 +178,8 @@ def _make_kernel(use_ring: bool) -> Any:
 
     @njit(cache=True, nogil=True)
     def kernel(
-        cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, cq, cf, gen,
-        start, goal, wp, corner_cutting, max_exp, root, ox, oy, res,
+        cell, f8, u64, i32, meta, gen, start, goal, wp, corner_cutting, max_exp, root, ox, oy,
+        res,
     ):
         """Run A* until the goal is closed, the open list empties or ``max_exp`` expansions.
 
@@ -231,6 +231,21 @@ def _make_kernel(use_ring: bool) -> Any:
         ``(ox, oy)`` and cell side ``res``, and ``g`` of the goal; else two
         empty (0, 2) arrays and ``inf``.
         """
+        # the buffers, packed by dtype in four arrays (one unboxing each per call, not
+        # twelve: issue 21), as views: f8 = g (one per cell) | cf (8); u64 = qkey (cap) |
+        # skey (cap) | bits | cq (8); i32 = heads | qnode (cap) | qnext (cap) | snode (cap)
+        nc = cell.shape[0]
+        gbuf = f8[:nc]
+        cf = f8[nc:]
+        pc = (i32.shape[0] - _RING_SIZE) // 3
+        heads = i32[:_RING_SIZE]
+        qnode = i32[_RING_SIZE:_RING_SIZE + pc]
+        qnext = i32[_RING_SIZE + pc:_RING_SIZE + 2 * pc]
+        snode = i32[_RING_SIZE + 2 * pc:]
+        qkey = u64[:pc]
+        skey = u64[pc:2 * pc]
+        bits = u64[2 * pc:2 * pc + _RING_SIZE // 64]
+        cq = u64[2 * pc + _RING_SIZE // 64:]
         s2 = 1.4142135623730951
         one = np.uint64(1)
         rmask = _RING_SIZE - 1

@@ -220,8 +220,10 @@ def test_quick_plan_taken_only_where_nothing_is_left_to_check(monkeypatch):
         assert run_mod.quick_plan(spec, cfg, g, s, bad, None) is None, bad
     assert run_mod.quick_plan(spec, cfg, g, s, t, "budget") is None
     assert run_mod.quick_plan(spec, cfg, g.occupied, s, t, None) is None
-    assert run_mod.quick_plan(spec, make_params(spec, {"heuristic": "octile"}), g, s, t,
-                              None) is None  # not planned with these parameters yet
+    other = make_params(spec, {"heuristic": "octile", "lookahead_time_s": 1.2345})
+    assert run_mod.quick_plan(spec, other, g, s, t, None) is None  # not planned with yet
+    pathfuse.plan(g, s, t, heuristic="octile", lookahead_time_s=1.2345)
+    assert run_mod.quick_plan(spec, other, g, s, t, None) is not None
     monkeypatch.setattr(run_mod, "_LANE", False)
     assert run_mod.quick_plan(spec, cfg, g, s, t, None) is None
 

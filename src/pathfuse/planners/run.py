@@ -29,7 +29,7 @@ from pathfuse.planners.globals.builtin import run_global
 from pathfuse.planners.registry import GLOBAL_PLANNERS, PlannerSpec, make_params
 from pathfuse.problem import _DEFAULT_BUDGET, Problem
 from pathfuse.result import Budget, ConfigError, PlanResult, Status, _FoundPath, path_length
-from pathfuse.search.astar import HEURISTICS, SearchResult, get_searcher
+from pathfuse.search.astar import HEURISTICS, AStarSearcher, SearchResult, get_searcher
 from pathfuse.validate import short as _shown
 
 __all__ = ["solve", "quick_plan", "start_online", "warm", "warm_query", "Stopped", "PlanInfo"]
@@ -222,13 +222,14 @@ def _astar_as_planned(spec: PlannerSpec, problem: Problem, params: Any) -> PlanR
 
 def _lane(name: str, grid: GridMap, start: tuple[float, float], goal: tuple[float, float],
           start_cell: tuple[int, int], goal_cell: tuple[int, int], budget: Budget,
-          heuristic: str, cut: bool) -> PlanResult:
+          heuristic: str, cut: bool, searcher: AStarSearcher | None = None) -> PlanResult:
     """The body of :func:`_astar_as_planned` and of :func:`quick_plan`: the search of a
     point robot's checked query (cells in the map and free, a known heuristic) and its
-    result."""
+    result; ``searcher``: the map's (:func:`get_searcher`), when the caller has it."""
     limit = budget.time_limit_s
     res_m = grid.resolution
-    searcher = get_searcher(grid, cut)
+    if searcher is None:
+        searcher = get_searcher(grid, cut)
     t0 = time.perf_counter()
     status, cells, cost, expansions, points = searcher.search_fields(
         start_cell, goal_cell, heuristic, budget.max_iterations, limit,
@@ -312,13 +313,20 @@ def quick_plan(spec: PlannerSpec, params: Any, grid: object, start: object, goal
         gr, gc = math.floor((gy - oy) / res), math.floor((gx - ox) / res)
     except (ValueError, OverflowError):
         return None
-    occ = grid.occupied
-    h, w = occ.shape
-    if not (0 <= sr < h and 0 <= sc < w and 0 <= gr < h and 0 <= gc < w) or \
-            occ[sr, sc] or occ[gr, gc]:
+    searcher = get_searcher(grid, hit[3])
+    h, w = searcher.shape
+    if not (0 <= sr < h and 0 <= sc < w and 0 <= gr < h and 0 <= gc < w):
         return None
+    flat = searcher._flat  # a small map's labels as a list: 0 on a blocked cell
+    if flat is not None:
+        if not flat[sr * w + sc] or not flat[gr * w + gc]:
+            return None
+    else:
+        occ = grid.occupied
+        if occ[sr, sc] or occ[gr, gc]:
+            return None
     return _lane(spec.name, grid, start, goal, (sr, sc), (gr, gc), budget, hit[2],
-                 hit[3])
+                 hit[3], searcher)
 
 
 def _renamed(res: PlanResult, name: str) -> PlanResult:

@@ -92,6 +92,7 @@ from pathfuse.result import (
 from pathfuse.search.kernel import (
     _BLOCKED,
     _CHUNK,
+    _RADIX_HEADS,
     _RING_SIZE,
     _STAMP_LIMIT,
     _astar_radix,
@@ -113,6 +114,7 @@ HEURISTICS = ("euclidean", "octile")
 """Accepted heuristic names."""
 
 _EAGER_LABELS = 1 << 21  # maps of more cells label their regions on first need
+_FLAT_LABELS = 1 << 16  # maps of at most this many cells also keep them as a Python list
 _NO_CELLS = np.zeros((0, 2), dtype=np.int64)
 _NO_CELLS.setflags(write=False)
 _NO_POINTS = np.zeros((0, 2))
@@ -162,6 +164,12 @@ class _Regions:
             self._labels = np.asarray(labels)
         elif occ.size <= _EAGER_LABELS:
             self._labels = self._make_labels()
+        # on a small map, the labels as a list of row-major ints too: a query's label test
+        # without numpy's indexing (issue 21: on a 32 x 32 map every step of a query counts)
+        self._flat: list[int] | None = None
+        if self._labels is not None and occ.size <= _FLAT_LABELS and \
+                self._labels.shape == occ.shape:
+            self._flat = self._labels.ravel().tolist()
 
     def _make_labels(self) -> np.ndarray:
         """The component labels of the free cells under this searcher's corner rule (the
@@ -225,19 +233,21 @@ class AStarSearcher(_Regions):
         """The open list's buffers for a pool and heap of ``cap`` entries, packed by dtype
         in two arrays that the kernel takes apart (5 arrays to unbox per call, not 12:
         issue 21): ``_u64`` = qkey | skey | bits | cq (the scratch of one expansion's
-        queued neighbours) and ``_i32`` = heads | qnode | qnext | snode, each part also
+        queued neighbours) and ``_i32`` = heads (the ring's) | rheads (the radix heap's) |
+        qnode | qnext | snode, each part also
         kept as a view under its own name.  With ``old``, its entries are copied (they
         keep their indices; the ring's heads and bits too, a search paused midway resumes
         on them)."""
         nb = _RING_SIZE // 64
+        h0 = _RING_SIZE + _RADIX_HEADS
         u64 = np.empty(2 * cap + nb + 8, dtype=np.uint64)
-        i32 = np.empty(_RING_SIZE + 3 * cap, dtype=np.int32)
+        i32 = np.empty(h0 + 3 * cap, dtype=np.int32)
         self._qkey, self._skey = u64[:cap], u64[cap:2 * cap]
         self._bits, self._cq = u64[2 * cap:2 * cap + nb], u64[2 * cap + nb:]
-        self._heads = i32[:_RING_SIZE]
-        self._qnode = i32[_RING_SIZE:_RING_SIZE + cap]
-        self._qnext = i32[_RING_SIZE + cap:_RING_SIZE + 2 * cap]
-        self._snode = i32[_RING_SIZE + 2 * cap:]
+        self._heads, self._rheads = i32[:_RING_SIZE], i32[_RING_SIZE:h0]
+        self._qnode = i32[h0:h0 + cap]
+        self._qnext = i32[h0 + cap:h0 + 2 * cap]
+        self._snode = i32[h0 + 2 * cap:]
         self._cf = self._f8[self._g.shape[0]:]
         if old is not None:
             for name, src in old.items():
@@ -247,7 +257,7 @@ class AStarSearcher(_Regions):
     def _grow_heap(self) -> None:
         """Double the open-list pool and heap (entries keep their indices)."""
         self._pack(2 * self._qkey.shape[0], {name: getattr(self, name) for name in (
-            "_qkey", "_skey", "_qnode", "_qnext", "_snode", "_heads", "_bits")})
+            "_qkey", "_skey", "_qnode", "_qnext", "_snode", "_heads", "_rheads", "_bits")})
 
     def search(
         self,
@@ -316,9 +326,15 @@ class AStarSearcher(_Regions):
                 ox, oy, res = origin
                 return (Status.SUCCESS, np.array([[sr, sc]], dtype=np.int64), 0.0, 0,
                         np.array([[ox + (sc + 0.5) * res, oy + (sr + 0.5) * res]]))
-            labels = self._labels
-            if labels is not None and labels[sr, sc] != labels[gr, gc]:
-                return Status.NO_PATH, _NO_CELLS, math.inf, 0, _NO_POINTS
+            flat = self._flat
+            if flat is not None:
+                w = self.shape[1]
+                if flat[sr * w + sc] != flat[gr * w + gc]:
+                    return Status.NO_PATH, _NO_CELLS, math.inf, 0, _NO_POINTS
+            else:
+                labels = self._labels
+                if labels is not None and labels[sr, sc] != labels[gr, gc]:
+                    return Status.NO_PATH, _NO_CELLS, math.inf, 0, _NO_POINTS
             # a search never expands more than the free cells: a larger budget (even 10**30)
             # means no cap, and stays within the kernel's 64-bit integers
             budget = self.free_count if max_expansions is None else \

@@ -6,13 +6,15 @@ Each layer is timed in the ``astar`` slot of ``bench_search.py``'s rotation of t
 that it finds the caches as ``plan()`` finds them there: right after pyastar2d, itself
 after scipy's Dijkstra.  Layers, outermost first:
 
-* ``plan``: :func:`pathfuse.plan` with its defaults;
+* ``plan``: :func:`pathfuse.plan` with its defaults (where the code has it, through
+  ``run.quick_plan``, without a ``Problem``);
 * ``create+solve``: ``Problem.create`` then ``run.solve`` (no registry look-up);
 * ``solve(pre)``: ``run.solve`` on a problem made beforehand;
 * ``lane(pre)``: the lane ``run._astar_as_planned`` on a problem made beforehand;
 * ``search_checked``: the map's A* searcher (``SearchResult`` included);
 * ``kernel``: the euclidean kernel's compiled entry alone (it traces the path when the
-  code has the trace in the kernel; an older code's separate trace is left out);
+  code has the trace in the kernel; an older code's separate trace is left out), with the
+  buffers as the code passes them (packed by dtype, or one array each);
 * ``noop``: an empty call (the timer's own cost).
 
 Queries: the hardest (``--hard`` longest scenario lines) and mixed ones (``--mixed``

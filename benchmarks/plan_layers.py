@@ -6,13 +6,15 @@ Each layer is timed in the ``astar`` slot of ``bench_search.py``'s rotation of t
 that it finds the caches as ``plan()`` finds them there: right after pyastar2d, itself
 after scipy's Dijkstra.  Layers, outermost first:
 
-* ``plan``: :func:`pathfuse.plan` with its defaults;
+* ``plan``: :func:`pathfuse.plan` with its defaults (where the code has it, through
+  ``run.quick_plan``, without a ``Problem``);
 * ``create+solve``: ``Problem.create`` then ``run.solve`` (no registry look-up);
 * ``solve(pre)``: ``run.solve`` on a problem made beforehand;
 * ``lane(pre)``: the lane ``run._astar_as_planned`` on a problem made beforehand;
 * ``search_checked``: the map's A* searcher (``SearchResult`` included);
 * ``kernel``: the euclidean kernel's compiled entry alone (it traces the path when the
-  code has the trace in the kernel; an older code's separate trace is left out);
+  code has the trace in the kernel; an older code's separate trace is left out), with the
+  buffers as the code passes them (packed by dtype, or one array each);
 * ``noop``: an empty call (the timer's own cost).
 
 Queries: the hardest (``--hard`` longest scenario lines) and mixed ones (``--mixed``
@@ -71,12 +73,17 @@ def layers(g: Any) -> dict[str, Any]:
         wp = s._wp
         s._gen += 2
         start = (sr + 1) * wp + sc + 1
-        args: tuple[Any, ...] = (
-            s._cell, s._g, s._qkey, s._qnode, s._qnext, s._heads, s._bits, s._skey,
-            s._snode, s._meta, s._cq, s._cf, s._gen, start, (gr + 1) * wp + gc + 1, wp,
-            False, s.free_count)
-        if s._meta.size >= 6:  # the kernel that traces the path itself
-            args += (start, 0.0, 0.0, 1.0)
+        goal = (gr + 1) * wp + gc + 1
+        args: tuple[Any, ...]
+        if hasattr(s, "_u64"):  # the buffers packed by dtype
+            args = (s._cell, s._f8, s._u64, s._i32, s._meta, s._gen, start, goal, wp, False,
+                    s.free_count, start, 0.0, 0.0, 1.0)
+        else:
+            args = (s._cell, s._g, s._qkey, s._qnode, s._qnext, s._heads, s._bits, s._skey,
+                    s._snode, s._meta, s._cq, s._cf, s._gen, start, goal, wp, False,
+                    s.free_count)
+            if s._meta.size >= 6:  # the kernel that traces the path itself
+                args += (start, 0.0, 0.0, 1.0)
         return int(A._KERNEL_ENTRY["euclidean"](*args)[1])
 
     return {

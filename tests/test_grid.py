@@ -72,6 +72,32 @@ def test_occupancy_is_read_only_copy():
         g.occupied[0, 0] = True
 
 
+def test_map_arrays_cannot_be_made_writeable_again_even_after_pickling():
+    """The searchers, inflations and labels cached per map rely on the map never changing:
+    numpy lets an array's owner turn writing back on, and an unpickled array (a study's
+    worker) is writeable; a map's arrays refuse both."""
+    import pickle
+
+    import pathfuse
+
+    g = GridMap.from_rows(["....#", ".##.#", "....."], resolution=0.5)
+    before = pathfuse.plan(g, (0.25, 0.25), (1.75, 1.25), planner="astar")
+    assert before.success
+    _ = g.components, g.distance_field
+    h = pickle.loads(pickle.dumps(g))
+    for m in (g, h):
+        for a in (m.occupied, m.components, m.distance_field):
+            assert not a.flags.writeable
+            with pytest.raises(ValueError):
+                a.setflags(write=True)
+            with pytest.raises(ValueError):
+                a[0, 0] = 1
+    assert np.array_equal(h.occupied, g.occupied)
+    again = pathfuse.plan(h, (0.25, 0.25), (1.75, 1.25), planner="astar")
+    assert again.success and again.length == before.length
+    assert np.array_equal(again.path, before.path)
+
+
 def _square_distance_oracle(occ, res, r):
     """Brute force: centre-to-square distance < r for any occupied square."""
     h, w = occ.shape

@@ -44,8 +44,9 @@ def _queries(g: GridMap, n: int, seed: int) -> list[tuple[tuple[float, float], .
     for _ in range(n):
         a, b = free[rng.integers(len(free))], free[rng.integers(len(free))]
         ja, jb = rng.random(2), rng.random(2)  # anywhere inside the cells, not only centres
-        out.append(((ox + (a[1] + ja[0]) * res, oy + (a[0] + ja[1]) * res),
-                    (ox + (b[1] + jb[0]) * res, oy + (b[0] + jb[1]) * res)))
+        # plain floats, as plan()'s quick path takes them
+        out.append(((float(ox + (a[1] + ja[0]) * res), float(oy + (a[0] + ja[1]) * res)),
+                    (float(ox + (b[1] + jb[0]) * res), float(oy + (b[0] + jb[1]) * res))))
     out.append((out[0][0], out[0][0]))  # start == goal
     return out
 
@@ -71,19 +72,23 @@ def _same(a: pathfuse.PlanResult, b: pathfuse.PlanResult) -> None:
 
 def _both(monkeypatch, *args, **kw):
     calls = []
-    lane = run_mod._astar_as_planned
+    lane = run_mod._lane  # the body of solve()'s lane and of plan()'s quick_plan
 
     def counted(*a, **k):
         calls.append(1)
         return lane(*a, **k)
 
-    monkeypatch.setattr(run_mod, "_astar_as_planned", counted)
+    monkeypatch.setattr(run_mod, "_lane", counted)
     fast = pathfuse.plan(*args, **kw)
+    again = pathfuse.plan(*args, **kw)  # after the first: plan()'s quick_plan, where it applies
     monkeypatch.setattr(run_mod, "_LANE", False)
     slow = pathfuse.plan(*args, **kw)
+    slow2 = pathfuse.plan(*args, **kw)  # _same adds min_clearance_m to both infos it reads
     monkeypatch.setattr(run_mod, "_LANE", True)
     _same(fast, slow)
-    return fast, len(calls)
+    _same(again, slow2)
+    assert len(calls) in (0, 2)  # both plans took the lane, or neither
+    return fast, len(calls) // 2
 
 
 @pytest.mark.parametrize("planner", ["astar", "astar-replan", "astar-follow"])
@@ -194,3 +199,80 @@ def test_solve_reports_the_problems_failure(radius):
             seen.add(r.status.name)
     assert {"SUCCESS", "START_OUT_OF_BOUNDS", "GOAL_OUT_OF_BOUNDS", "START_OCCUPIED",
             "GOAL_OCCUPIED"} <= seen
+
+
+def test_quick_plan_taken_only_where_nothing_is_left_to_check(monkeypatch):
+    g = GridMap.from_rows(["......", "..#...", "..#...", "......"], resolution=0.5,
+                          origin=(1.0, -2.0))
+    spec = get_planner("astar")
+    from pathfuse.planners.registry import make_params
+
+    cfg = make_params(spec, None)
+    s, t = (1.25, -1.75), (3.75, -0.25)
+    pathfuse.plan(g, s, t)  # solve() took the lane: remembered
+    quick = run_mod.quick_plan(spec, cfg, g, s, t, None)
+    assert quick is not None
+    _same(quick, pathfuse.plan(g, s, t, robot_radius_m=0.0))  # through solve()
+    # anything plan() must check, or an outcome other than a search's: None
+    for bad in ((float("nan"), -1.75), (1, -1.75), [1.25, -1.75], (1.25,), (0.0, -1.75),
+                (2.25, -1.25), np.array([1.25, -1.75])):
+        assert run_mod.quick_plan(spec, cfg, g, bad, t, None) is None, bad
+        assert run_mod.quick_plan(spec, cfg, g, s, bad, None) is None, bad
+    assert run_mod.quick_plan(spec, cfg, g, s, t, "budget") is None
+    assert run_mod.quick_plan(spec, cfg, g.occupied, s, t, None) is None
+    other = make_params(spec, {"heuristic": "octile", "lookahead_time_s": 1.2345})
+    assert run_mod.quick_plan(spec, other, g, s, t, None) is None  # not planned with yet
+    pathfuse.plan(g, s, t, heuristic="octile", lookahead_time_s=1.2345)
+    assert run_mod.quick_plan(spec, other, g, s, t, None) is not None
+    monkeypatch.setattr(run_mod, "_LANE", False)
+    assert run_mod.quick_plan(spec, cfg, g, s, t, None) is None
+
+
+@pytest.mark.parametrize("start, error, words", [
+    ((float("nan"), 0.5), "QueryError", "start"),
+    ((0.5, float("inf")), "QueryError", "start"),
+    (("a", 0.5), "QueryError", "start"),
+    ((0.5,), "QueryError", "start"),
+])
+def test_plan_checks_bad_input_after_warm_paths(start, error, words):
+    g = GridMap.from_rows(["....", ".##.", "...."])
+    pathfuse.plan(g, (0.5, 0.5), (3.5, 2.5))  # the quick path is open for these parameters
+    with pytest.raises(getattr(pathfuse, error)) as e:
+        pathfuse.plan(g, start, (3.5, 2.5))
+    assert words in str(e.value)
+    with pytest.raises(getattr(pathfuse, error)) as e:
+        pathfuse.plan(g, (3.5, 2.5), start)
+    assert "goal" in str(e.value)
+    with pytest.raises(pathfuse.QueryError, match="grid"):
+        pathfuse.plan(g.occupied, (0.5, 0.5), (3.5, 2.5))
+    with pytest.raises(ConfigError, match="budget"):
+        pathfuse.plan(g, (0.5, 0.5), (3.5, 2.5), budget=5)
+    with pytest.raises(ConfigError, match="clearance_m"):
+        pathfuse.plan(g, (0.5, 0.5), (3.5, 2.5), clearance_m=float("nan"))
+
+
+def test_found_path_result_is_a_plan_result():
+    import copy
+    import dataclasses
+    import pickle
+
+    from pathfuse.planners.globals.astar import found_message
+
+    g = GridMap.from_rows(["......", "..#...", "..#...", "......"], resolution=0.5)
+    r = pathfuse.plan(g, (0.25, 0.25), (2.75, 1.75))
+    assert isinstance(r, pathfuse.PlanResult) and r
+    assert "message" not in r.__dict__  # written on first read
+    text = found_message(len(r.info["cells"]), r.length, r.expansions)
+    assert r.message == text and r.__dict__["message"] == text
+    assert repr(r).startswith("PlanResult(status=<Status.SUCCESS")
+    assert dataclasses.asdict(r)["message"] == text
+    assert r.to_dict()["message"] == text
+    fresh = pathfuse.plan(g, (0.25, 0.25), (2.75, 1.75))
+    for back in (pickle.loads(pickle.dumps(fresh)), copy.copy(fresh),
+                 dataclasses.replace(fresh, planner="other")):
+        assert isinstance(back, pathfuse.PlanResult) and back.message == text
+        assert np.array_equal(back.path, r.path) and back.length == r.length
+    assert type(pickle.loads(pickle.dumps(fresh))) is pathfuse.PlanResult
+    assert dataclasses.replace(fresh, planner="other").planner == "other"
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fresh.message = "x"  # type: ignore[misc]

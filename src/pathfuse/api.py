@@ -8,7 +8,7 @@ from typing import Any, NamedTuple
 
 from pathfuse.grid import GridMap
 from pathfuse.planners.registry import PlannerSpec, get_planner, make_params
-from pathfuse.planners.run import solve
+from pathfuse.planners.run import quick_plan, solve
 from pathfuse.problem import Problem
 from pathfuse.result import Budget, PlanResult
 
@@ -130,6 +130,11 @@ def plan(
     # plan_query's body without its Planned tuple (the same checks in the same order)
     spec = get_planner(planner)
     cfg = make_params(spec, params)
+    if robot_radius_m is None and robot is None and type(clearance_m) is float and \
+            clearance_m == 0.0:  # a point robot: A*'s path as planned needs no Problem
+        res = quick_plan(spec, cfg, grid, start, goal, budget)
+        if res is not None:
+            return res
     if robot_radius_m is None:  # None has no radius_m: no attribute look-up that fails
         robot_radius_m = 0.0 if robot is None else getattr(robot, "radius_m", 0.0)
     return solve(spec, Problem.create(grid, start, goal, robot_radius_m, budget, clearance_m,

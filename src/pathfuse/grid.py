@@ -111,6 +111,19 @@ def _as_points(xy: object, what: str = "point") -> np.ndarray:
     return p
 
 
+def _locked(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a`` (which the caller no longer writes) that cannot be made
+    writeable again.
+
+    numpy lets the owner of a buffer turn writing back on (``setflags(write=True)``),
+    and an unpickled array is writeable; a view of a read-only buffer can never be.
+    The searchers, inflations and labels cached per map rely on the map not changing.
+    """
+    buf = a if a.base is None else a.copy()
+    buf.setflags(write=False)
+    return buf.view()
+
+
 @dataclass(frozen=True, eq=False)
 class GridMap:
     """A 2-D occupancy grid with a metric frame.
@@ -155,8 +168,7 @@ class GridMap:
             if not np.issubdtype(occ.dtype, np.number):
                 raise MapError(f"occupancy must be boolean or numeric, got dtype {occ.dtype}")
             occ = occ != 0
-        occ = np.ascontiguousarray(occ, dtype=np.bool_).copy()
-        occ.setflags(write=False)
+        occ = _locked(np.ascontiguousarray(occ, dtype=np.bool_).copy())
         object.__setattr__(self, "occupied", occ)
         try:
             res = float(self.resolution)
@@ -409,8 +421,7 @@ class GridMap:
             df = np.full(self.shape, np.inf)
         else:
             df = ndimage.distance_transform_edt(~self.occupied) * self.resolution
-        df.setflags(write=False)
-        return df
+        return _locked(df)
 
     @cached_property
     def components(self) -> np.ndarray:
@@ -418,9 +429,12 @@ class GridMap:
 
         4-connectivity, which equals 8-connectivity without corner cutting.
         """
-        labels = label_regions(~self.occupied)
-        labels.setflags(write=False)
-        return labels
+        return _locked(label_regions(~self.occupied))
+
+    def __setstate__(self, state: dict) -> None:
+        """Unpickled (a study's worker, Dask): the arrays are read-only again."""
+        self.__dict__.update({k: _locked(v) if isinstance(v, np.ndarray) else v
+                              for k, v in state.items()})
 
     def __repr__(self) -> str:
         return (

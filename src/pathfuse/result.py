@@ -307,6 +307,63 @@ class PlanResult:
         }
 
 
+
+class _FoundMessage:
+    """The ``message`` of a :class:`_FoundPath`: written on first read (a non-data
+    descriptor, so the instance's own ``message``, once stored, is read directly)."""
+
+    def __get__(self, obj: Any, cls: Any = None) -> str:
+        if obj is None:
+            return ""  # the field's default, as on PlanResult
+        msg = (f"path through {obj.path.shape[0]} cells, {obj.length:.6g} m, "
+               f"{obj.expansions} expansions")
+        obj.__dict__["message"] = msg
+        return msg
+
+
+class _FoundPath(PlanResult):
+    """A :class:`PlanResult` of a grid path found (``plan()``'s A* lane) whose message,
+    ``"path through N cells, L m, E expansions"`` (``found_message`` of
+    :mod:`pathfuse.planners.globals.astar`), is written when first read: formatting it
+    was about a tenth of a query on a 32 x 32 map (issue 21).  Everything else is a
+    :class:`PlanResult`'s: its fields, its ``repr``, and pickling and copying make a
+    plain :class:`PlanResult` with the message written.
+
+    >>> import numpy as np
+    >>> r = _FoundPath._made(Status.SUCCESS, np.zeros((3, 2)), 2.5, 0.0, "astar", 7, 0,
+    ...                      None, {})
+    >>> r.message, repr(r).startswith("PlanResult(status=")
+    ('path through 3 cells, 2.5 m, 7 expansions', True)
+    """
+
+    message = _FoundMessage()  # type: ignore[assignment]
+
+    @classmethod
+    def _made(cls, status: Status, path: np.ndarray, length: float, time_s: float,
+              planner: str, expansions: int, iterations: int, message: str | None,
+              info: dict[str, Any]) -> PlanResult:
+        """:meth:`PlanResult._made` without the message (``message`` is ignored)."""
+        obj = object.__new__(cls)
+        d = obj.__dict__
+        d["status"] = status
+        d["path"] = path
+        d["length"] = length
+        d["time_s"] = time_s
+        d["planner"] = planner
+        d["expansions"] = expansions
+        d["iterations"] = iterations
+        d["info"] = info
+        return obj
+
+    def __reduce__(self) -> Any:
+        return (PlanResult._made, (self.status, self.path, self.length, self.time_s,
+                                   self.planner, self.expansions, self.iterations,
+                                   self.message, self.info))
+
+
+_FoundPath.__qualname__ = "PlanResult"  # its repr is a PlanResult's
+
+
 def path_length(path: np.ndarray) -> float:
     """Sum of segment lengths of an (N, 2) path; 0 for fewer than two points.
 

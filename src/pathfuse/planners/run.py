@@ -13,24 +13,26 @@ compilation.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from pathfuse.grid import GridMap
 from pathfuse.metrics import PlanInfo
 from pathfuse.planners.base import Controller, Observed
 from pathfuse.planners.globals.astar import GlobalPlan, searched
 from pathfuse.planners.globals.builtin import _astar as _builtin_astar
 from pathfuse.planners.globals.builtin import run_global
 from pathfuse.planners.registry import GLOBAL_PLANNERS, PlannerSpec, make_params
-from pathfuse.problem import Problem
-from pathfuse.result import ConfigError, PlanResult, Status, path_length
-from pathfuse.search.astar import HEURISTICS, SearchResult, get_searcher
+from pathfuse.problem import _DEFAULT_BUDGET, Problem
+from pathfuse.result import Budget, ConfigError, PlanResult, Status, _FoundPath, path_length
+from pathfuse.search.astar import HEURISTICS, AStarSearcher, SearchResult, get_searcher
 from pathfuse.validate import short as _shown
 
-__all__ = ["solve", "start_online", "warm", "warm_query", "Stopped", "PlanInfo"]
+__all__ = ["solve", "quick_plan", "start_online", "warm", "warm_query", "Stopped", "PlanInfo"]
 
 _WARM: set[tuple[str, str | None, bool, bool, bool, str | None]] = set()
 _WARM_SEGMENT: list[bool] = []
@@ -152,7 +154,9 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
             (_AS_PLANNED.get(ctrl_cls) or _as_planned(ctrl_cls)):
         gs = GLOBAL_PLANNERS.get("astar")  # registered by now: warm() looked it up
         if gs is not None and gs.func is _builtin_astar and gs.plugin is None:  # not a plug-in
-            return _astar_as_planned(spec, problem, params)
+            res = _astar_as_planned(spec, problem, params)
+            _remember(spec, params)
+            return res
     deadline = (time.perf_counter() + budget.time_limit_s
                 if budget.time_limit_s is not None else None)
     gp = None
@@ -212,30 +216,117 @@ def _astar_as_planned(spec: PlannerSpec, problem: Problem, params: Any) -> PlanR
     if heuristic not in HEURISTICS:  # plan_global's check (the parameters have made it)
         raise ConfigError(f"heuristic: must be one of {', '.join(map(repr, HEURISTICS))}, "
                           f"got {_shown(heuristic)}")
-    grid = problem.grid
-    budget = problem.budget
+    return _lane(spec.name, problem.grid, problem.start, problem.goal, problem.start_cell,
+                 problem.goal_cell, problem.budget, heuristic, cut)
+
+
+def _lane(name: str, grid: GridMap, start: tuple[float, float], goal: tuple[float, float],
+          start_cell: tuple[int, int], goal_cell: tuple[int, int], budget: Budget,
+          heuristic: str, cut: bool, searcher: AStarSearcher | None = None) -> PlanResult:
+    """The body of :func:`_astar_as_planned` and of :func:`quick_plan`: the search of a
+    point robot's checked query (cells in the map and free, a known heuristic) and its
+    result; ``searcher``: the map's (:func:`get_searcher`), when the caller has it."""
     limit = budget.time_limit_s
-    ox, oy = grid.origin
     res_m = grid.resolution
-    searcher = get_searcher(grid, cut)
+    if searcher is None:
+        searcher = get_searcher(grid, cut)
     t0 = time.perf_counter()
     status, cells, cost, expansions, points = searcher.search_fields(
-        problem.start_cell, problem.goal_cell, heuristic, budget.max_iterations, limit,
-        (ox, oy, res_m))
+        start_cell, goal_cell, heuristic, budget.max_iterations, limit,
+        (grid.origin[0], grid.origin[1], res_m))
     elapsed = time.perf_counter() - t0
     if status is not Status.SUCCESS:
+        problem = Problem._made(grid, start, goal, 0.0, budget, start_cell, goal_cell, 0.0,
+                                None)
         gp = searched(problem, SearchResult(status, cells, cost, expansions, points), elapsed,
                       limit, heuristic, cut)
-        return PlanResult(gp.status, time_s=gp.time_s, planner=spec.name,
+        return PlanResult(gp.status, time_s=gp.time_s, planner=name,
                           expansions=gp.expansions, message=gp.message, info=_astar_info(gp))
     length = cost * res_m
     info = PlanInfo(cells=cells, cost_cells=length / res_m, heuristic=heuristic,
                     corner_cutting=cut)
-    info._bound = (grid, points, float(problem.robot_radius_m))  # bind()'s body
-    # found_message's text, written out
-    return PlanResult._made(Status.SUCCESS, points, length, elapsed + 0.0, spec.name,
-                            expansions, 0, f"path through {len(cells)} cells, "
-                            f"{length:.6g} m, {expansions} expansions", info)
+    info._bound = (grid, points, 0.0)  # bind()'s body (a point robot)
+    # the message (found_message's text) is written when first read
+    return _FoundPath._made(Status.SUCCESS, points, length, elapsed + 0.0, name, expansions,
+                            0, None, info)
+
+
+#: The plans that took the lane in :func:`solve`, by ``id`` of their parameters: the
+#: parameters (so that a new object at a freed ``id`` is not taken for them), the spec,
+#: the heuristic, the corner rule, :func:`warm`'s key and the global planner ``astar``'s
+#: registry entry, the built-in's (see :func:`quick_plan`).
+_QUICK: dict[int, tuple[Any, PlannerSpec, str, bool, tuple[Any, ...], Any]] = {}
+
+
+def _remember(spec: PlannerSpec, params: Any) -> None:
+    """Note that ``solve(spec, problem, params)`` took the lane (it warmed the kernels and
+    checked the parameters' heuristic) with the global planner ``astar`` registered now,
+    for :func:`quick_plan` (a later plan that takes the lane in ``solve`` notes it again:
+    a plug-in may have come and gone)."""
+    if len(_QUICK) >= 256 and id(params) not in _QUICK:
+        _QUICK.clear()
+    _QUICK[id(params)] = (params, spec, getattr(params, "heuristic", "euclidean"),
+                          bool(getattr(params, "corner_cutting", False)),
+                          (spec.name, "astar", False, False, False,
+                           getattr(params, "heuristic", None)),
+                          GLOBAL_PLANNERS.get("astar"))
+
+
+def quick_plan(spec: PlannerSpec, params: Any, grid: object, start: object, goal: object,
+               budget: object) -> PlanResult | None:
+    """:func:`pathfuse.plan`'s result for a point robot without a margin or a robot model,
+    without building the :class:`~pathfuse.problem.Problem`, or None where
+    ``solve(spec, Problem.create(...), params)`` must run (issue 21: on a 32 x 32 map
+    ``plan()``'s layers above the search cost as much as a third of pyastar2d's query).
+
+    It answers only what :func:`solve` would answer through :func:`_lane` with nothing
+    left to check: the same ``spec`` and ``params`` took the lane before (their kernels
+    are warm, the heuristic is a known one, no plug-in replaced the global planner
+    ``astar`` since), the map is a :class:`GridMap`, ``start`` and ``goal`` are tuples of
+    two finite floats (``Problem.create``'s own shortcut) in free cells of the map, and
+    ``budget`` is None or a :class:`Budget`.  Every other input, bad input included, gets
+    None: ``plan()`` then checks it as always.  ``tests/test_lane.py`` holds the results
+    equal to the layers'."""
+    hit = _QUICK.get(id(params))
+    if hit is None or hit[0] is not params or hit[1] is not spec or not _LANE or \
+            hit[4] not in _WARM or type(grid) is not GridMap or \
+            GLOBAL_PLANNERS.get("astar") is not hit[5]:  # a plug-in registered since
+        return None
+    if type(start) is not tuple or len(start) != 2 or type(goal) is not tuple or \
+            len(goal) != 2:
+        return None
+    sx, sy = start
+    gx, gy = goal
+    if type(sx) is not float or type(sy) is not float or type(gx) is not float or \
+            type(gy) is not float:
+        return None
+    if budget is None:
+        budget = _DEFAULT_BUDGET
+    elif type(budget) is not Budget:
+        return None
+    ox, oy = grid.origin
+    res = grid.resolution
+    # Problem.create's cells (floor raises on a NaN or an infinite coordinate, which
+    # Problem.create rejects) and failure()'s first test (in the map, free, a point robot)
+    try:
+        sr, sc = math.floor((sy - oy) / res), math.floor((sx - ox) / res)
+        gr, gc = math.floor((gy - oy) / res), math.floor((gx - ox) / res)
+    except (ValueError, OverflowError):
+        return None
+    searcher = get_searcher(grid, hit[3])
+    h, w = searcher.shape
+    if not (0 <= sr < h and 0 <= sc < w and 0 <= gr < h and 0 <= gc < w):
+        return None
+    flat = searcher._flat  # a small map's labels as a list: 0 on a blocked cell
+    if flat is not None:
+        if not flat[sr * w + sc] or not flat[gr * w + gc]:
+            return None
+    else:
+        occ = grid.occupied
+        if occ[sr, sc] or occ[gr, gc]:
+            return None
+    return _lane(spec.name, grid, start, goal, (sr, sc), (gr, gc), budget, hit[2],
+                 hit[3], searcher)
 
 
 def _renamed(res: PlanResult, name: str) -> PlanResult:

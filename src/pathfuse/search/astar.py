@@ -92,6 +92,7 @@ from pathfuse.result import (
 from pathfuse.search.kernel import (
     _BLOCKED,
     _CHUNK,
+    _RADIX_HEADS,
     _RING_SIZE,
     _STAMP_LIMIT,
     _astar_radix,
@@ -113,6 +114,7 @@ HEURISTICS = ("euclidean", "octile")
 """Accepted heuristic names."""
 
 _EAGER_LABELS = 1 << 21  # maps of more cells label their regions on first need
+_FLAT_LABELS = 1 << 16  # maps of at most this many cells also keep them as a Python list
 _NO_CELLS = np.zeros((0, 2), dtype=np.int64)
 _NO_CELLS.setflags(write=False)
 _NO_POINTS = np.zeros((0, 2))
@@ -162,6 +164,12 @@ class _Regions:
             self._labels = np.asarray(labels)
         elif occ.size <= _EAGER_LABELS:
             self._labels = self._make_labels()
+        # on a small map, the labels as a list of row-major ints too: a query's label test
+        # without numpy's indexing (issue 21: on a 32 x 32 map every step of a query counts)
+        self._flat: list[int] | None = None
+        if self._labels is not None and occ.size <= _FLAT_LABELS and \
+                self._labels.shape == occ.shape:
+            self._flat = self._labels.ravel().tolist()
 
     def _make_labels(self) -> np.ndarray:
         """The component labels of the free cells under this searcher's corner rule (the
@@ -210,31 +218,46 @@ class AStarSearcher(_Regions):
         np.multiply(occ, _BLOCKED, out=cell[1:-1, 1:-1], dtype=np.uint32)  # 3x a mask
         self._cell = cell.ravel()  # blocked / stamp and move: see kernel._make_kernel
         n = self._cell.size
-        self._g = np.empty(n, dtype=np.float64)
-        cap = int(min(max(1024, n // 4), 1 << 20))
-        self._qkey = np.empty(cap, dtype=np.uint64)
-        self._qnode = np.empty(cap, dtype=np.int32)
-        self._qnext = np.empty(cap, dtype=np.int32)
-        self._skey = np.empty(cap, dtype=np.uint64)
-        self._snode = np.empty(cap, dtype=np.int32)
-        self._heads = np.empty(_RING_SIZE, dtype=np.int32)
-        self._bits = np.empty(_RING_SIZE // 64, dtype=np.uint64)
+        # g and the kernel's scratch (one expansion's queued neighbours' f), in one array
+        self._f8 = np.empty(n + 8, dtype=np.float64)
+        self._g = self._f8[:n]
         self._meta = np.zeros(6, dtype=np.int64)  # see kernel._make_kernel
-        self._cq = np.empty(8, dtype=np.uint64)  # the kernel's scratch: one expansion's
-        self._cf = np.empty(8)  # queued neighbours and their f
+        self._pack(int(min(max(1024, n // 4), 1 << 20)), None)
         self._gen = 0
         self._closed_gen = -1  # stamp of the cells the last search closed (-1: none)
         self.free_count = int(occ.size - np.count_nonzero(occ))
         self._init_labels(occ, labels)
         self.lock = threading.Lock()
 
+    def _pack(self, cap: int, old: dict[str, np.ndarray] | None) -> None:
+        """The open list's buffers for a pool and heap of ``cap`` entries, packed by dtype
+        in two arrays that the kernel takes apart (5 arrays to unbox per call, not 12:
+        issue 21): ``_u64`` = qkey | skey | bits | cq (the scratch of one expansion's
+        queued neighbours) and ``_i32`` = heads (the ring's) | rheads (the radix heap's) |
+        qnode | qnext | snode, each part also
+        kept as a view under its own name.  With ``old``, its entries are copied (they
+        keep their indices; the ring's heads and bits too, a search paused midway resumes
+        on them)."""
+        nb = _RING_SIZE // 64
+        h0 = _RING_SIZE + _RADIX_HEADS
+        u64 = np.empty(2 * cap + nb + 8, dtype=np.uint64)
+        i32 = np.empty(h0 + 3 * cap, dtype=np.int32)
+        self._qkey, self._skey = u64[:cap], u64[cap:2 * cap]
+        self._bits, self._cq = u64[2 * cap:2 * cap + nb], u64[2 * cap + nb:]
+        self._heads, self._rheads = i32[:_RING_SIZE], i32[_RING_SIZE:h0]
+        self._qnode = i32[h0:h0 + cap]
+        self._qnext = i32[h0 + cap:h0 + 2 * cap]
+        self._snode = i32[h0 + 2 * cap:]
+        self._cf = self._f8[self._g.shape[0]:]
+        if old is not None:
+            for name, src in old.items():
+                getattr(self, name)[:src.shape[0]] = src
+        self._u64, self._i32 = u64, i32
+
     def _grow_heap(self) -> None:
         """Double the open-list pool and heap (entries keep their indices)."""
-        for name in ("_qkey", "_qnode", "_qnext", "_skey", "_snode"):
-            old = getattr(self, name)
-            new = np.empty(2 * old.shape[0], dtype=old.dtype)
-            new[: old.shape[0]] = old
-            setattr(self, name, new)
+        self._pack(2 * self._qkey.shape[0], {name: getattr(self, name) for name in (
+            "_qkey", "_skey", "_qnode", "_qnext", "_snode", "_heads", "_rheads", "_bits")})
 
     def search(
         self,
@@ -303,9 +326,15 @@ class AStarSearcher(_Regions):
                 ox, oy, res = origin
                 return (Status.SUCCESS, np.array([[sr, sc]], dtype=np.int64), 0.0, 0,
                         np.array([[ox + (sc + 0.5) * res, oy + (sr + 0.5) * res]]))
-            labels = self._labels
-            if labels is not None and labels[sr, sc] != labels[gr, gc]:
-                return Status.NO_PATH, _NO_CELLS, math.inf, 0, _NO_POINTS
+            flat = self._flat
+            if flat is not None:
+                w = self.shape[1]
+                if flat[sr * w + sc] != flat[gr * w + gc]:
+                    return Status.NO_PATH, _NO_CELLS, math.inf, 0, _NO_POINTS
+            else:
+                labels = self._labels
+                if labels is not None and labels[sr, sc] != labels[gr, gc]:
+                    return Status.NO_PATH, _NO_CELLS, math.inf, 0, _NO_POINTS
             # a search never expands more than the free cells: a larger budget (even 10**30)
             # means no cap, and stays within the kernel's 64-bit integers
             budget = self.free_count if max_expansions is None else \
@@ -327,9 +356,8 @@ class AStarSearcher(_Regions):
             while True:
                 step = min(chunk, budget - done)
                 code, n, cells, pts, cost = kernel(
-                    self._cell, self._g, self._qkey, self._qnode, self._qnext, self._heads,
-                    self._bits, self._skey, self._snode, self._meta, self._cq, self._cf, gen,
-                    first, goal, wp, self.corner_cutting, step, start, ox, oy, res,
+                    self._cell, self._f8, self._u64, self._i32, self._meta, gen, first, goal,
+                    wp, self.corner_cutting, step, start, ox, oy, res,
                 )
                 first = -1
                 done += n
@@ -409,6 +437,30 @@ _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _CACHE_LOCK = threading.Lock()
 
 
+def _dead() -> None:
+    return None
+
+
+#: The map of the last :func:`get_searcher` call (weakly) and its searchers: the look-up
+#: without :class:`weakref.WeakKeyDictionary`'s call (issue 21: a query on a small map
+#: pays for every layer); forgotten when the map goes.
+_LAST: tuple[Any, dict[bool, AStarSearcher] | None] = (_dead, None)
+
+
+def _remember(grid: Any, per_map: dict[bool, AStarSearcher]) -> None:
+    global _LAST
+
+    def forget(ref: Any) -> None:
+        global _LAST
+        if _LAST[0] is ref:
+            _LAST = (_dead, None)
+
+    try:
+        _LAST = (weakref.ref(grid, forget), per_map)
+    except TypeError:  # not weakly referable: the WeakKeyDictionary would have refused it
+        pass
+
+
 def get_searcher(grid, corner_cutting: bool = False) -> AStarSearcher:
     """The cached :class:`AStarSearcher` of ``grid`` (a GridMap) for a corner rule.
 
@@ -418,7 +470,13 @@ def get_searcher(grid, corner_cutting: bool = False) -> AStarSearcher:
     returned (its buffers are not cached).
     """
     key = bool(corner_cutting)
-    per_map = _CACHE.get(grid)  # a read needs no lock (the GIL); adding a map takes it
+    last = _LAST  # one read: the pair is replaced whole
+    if last[0]() is grid:  # the map of the last look-up (a loop of queries on one map)
+        per_map = last[1]
+    else:
+        per_map = _CACHE.get(grid)  # a read needs no lock (the GIL); adding a map takes it
+        if per_map is not None:
+            _remember(grid, per_map)
     searcher = per_map.get(key) if per_map is not None else None
     if searcher is not None:
         return _new_searcher(grid, key, searcher._labels) if searcher.lock.locked() \
@@ -429,6 +487,7 @@ def get_searcher(grid, corner_cutting: bool = False) -> AStarSearcher:
             per_map = {}
             _CACHE[grid] = per_map
         searcher = per_map.get(key)
+    _remember(grid, per_map)
     if searcher is None:
         searcher = _new_searcher(grid, key, None)
         with _CACHE_LOCK:
@@ -491,6 +550,6 @@ def warmup(heuristics: tuple[str, ...] = HEURISTICS) -> None:
     # the arguments of a search (the types are all that matters; nothing is called)
     for heur in todo:
         _KERNEL_ENTRY[heur] = _entry_point(_KERNEL_ENTRY[heur], (
-            s._cell, s._g, s._qkey, s._qnode, s._qnext, s._heads, s._bits, s._skey,
-            s._snode, s._meta, s._cq, s._cf, 2, 5, 7, s._wp, False, 1, 5, 0.0, 0.0, 1.0))
+            s._cell, s._f8, s._u64, s._i32, s._meta, 2, 5, 7, s._wp, False, 1, 5, 0.0, 0.0,
+            1.0))
     _WARM.update(todo)

@@ -17,6 +17,7 @@ from pathfuse.result import CODE_GROW, CODE_NO_PATH, CODE_RUNNING, CODE_SUCCESS
 _CHUNK = 1 << 16  # expansions between clock checks when a time limit is set
 _RING_SCALE = 1024.0  # ring buckets per cell of f (euclidean open list)
 _RING_SIZE = 4096  # > 2 * sqrt(2) * _RING_SCALE + 2, a power of two
+_RADIX_HEADS = 65  # the radix heap's buckets (a key and the last differ in bit 0..63, or not)
 _STAMP_LIMIT = (1 << 27) - 4  # stamps live in the 27 high bits of a cell's word
 _BLOCKED = np.uint32(0xFFFFFFFF)  # the word of a blocked (or border) cell
 
@@ -178,8 +179,8 @@ def _make_kernel(use_ring: bool) -> Any:
 
     @njit(cache=True, nogil=True)
     def kernel(
-        cell, gbuf, qkey, qnode, qnext, heads, bits, skey, snode, meta, cq, cf, gen,
-        start, goal, wp, corner_cutting, max_exp, root, ox, oy, res,
+        cell, f8, u64, i32, meta, gen, start, goal, wp, corner_cutting, max_exp, root, ox, oy,
+        res,
     ):
         """Run A* until the goal is closed, the open list empties or ``max_exp`` expansions.
 
@@ -231,6 +232,28 @@ def _make_kernel(use_ring: bool) -> Any:
         ``(ox, oy)`` and cell side ``res``, and ``g`` of the goal; else two
         empty (0, 2) arrays and ``inf``.
         """
+        # the buffers, packed by dtype in four arrays (one unboxing each per call, not
+        # twelve: issue 21), as views: f8 = g (one per cell) | cf (8); u64 = qkey (cap) |
+        # skey (cap) | bits | cq (8); i32 = the ring's heads | the radix heap's heads (65) |
+        # qnode (cap) | qnext (cap) | snode (cap).  Each open list has heads of its own, so
+        # an octile query leaves the ring empty for the next euclidean one (it cleared all
+        # 4096 buckets after each octile query when they shared them)
+        nc = cell.shape[0]
+        gbuf = f8[:nc]
+        cf = f8[nc:]
+        h0 = _RING_SIZE + _RADIX_HEADS
+        pc = (i32.shape[0] - h0) // 3
+        if use_ring:
+            heads = i32[:_RING_SIZE]
+        else:
+            heads = i32[_RING_SIZE:h0]
+        qnode = i32[h0:h0 + pc]
+        qnext = i32[h0 + pc:h0 + 2 * pc]
+        snode = i32[h0 + 2 * pc:]
+        qkey = u64[:pc]
+        skey = u64[pc:2 * pc]
+        bits = u64[2 * pc:2 * pc + _RING_SIZE // 64]
+        cq = u64[2 * pc + _RING_SIZE // 64:]
         s2 = 1.4142135623730951
         one = np.uint64(1)
         rmask = _RING_SIZE - 1
@@ -268,10 +291,8 @@ def _make_kernel(use_ring: bool) -> Any:
                 size = 0
                 ssize = _spush(skey, snode, np.int64(0), k0, start)
             else:
-                for i in range(65):
+                for i in range(_RADIX_HEADS):
                     heads[i] = -1
-                meta[5] = 0  # the radix heap fills the ring's first buckets (one searcher
-                # runs both kernels): the next euclidean query clears the ring
                 last = k0
                 cur = np.int64(0)
                 fh, used = _qpush(qkey, qnode, qnext, heads, last, fh, used, last, start)

@@ -186,17 +186,24 @@ class FusionParams(SocialParams, GlobalAStarParams, DiscParams, FieldParams, Glo
                     "against every disc (a wandering disc's constant-velocity prediction "
                     "shows its contact too late to escape); false = every disc")
     walker_escape: bool = param(
-        False, help="ours (diff-drive robot online, among_discs='mppi'): dwa's lane escape "
-                    "(planners/controllers/dwa_escape.py) on the sequences' command: while "
-                    "the robot standing would be touched within dwa's lane_escape_s (4 s) by "
-                    "a sensed disc not seen to wander, and so would the command, the first "
-                    "step of the best turn-then-go sequence out of the discs' lanes that none "
-                    "touches (kept with hysteresis); the shield still checks it; false = off")
+        True, help="ours (diff-drive robot online, among_discs='mppi'): dwa's lane escape "
+                   "(planners/controllers/dwa_escape.py) on the sequences' command: while "
+                   "the robot standing would be touched within walker_escape_s by a sensed "
+                   "disc not seen to wander, and so would the command, the first step of the "
+                   "best turn-then-go sequence out of the discs' lanes that none touches "
+                   "(kept with hysteresis); the shield still checks it; false = off (the "
+                   "default until 27 Nov, docs/guide/people.md)")
     walker_escape_hold: float = param(
         5.0, ge=0, le=1000,
         help="ours, with walker_escape: taken off the cost of the sequence towards the "
              "heading escaped towards last tick (hysteresis; dwa's HOLD_BONUS is 0.5, with "
              "which the escape's heading swung and east_three_lanes seed 0 collided)")
+    walker_escape_s: float = param(
+        3.5, gt=0, le=30, unit="s",
+        help="ours, with walker_escape: the escape's horizon: it is set off while "
+             "the robot standing would be touched within this time, and its "
+             "sequences are rolled out over it (dwa's lane_escape_s is 4 s, which the "
+             "walker escape used until 27 Nov)")
     escape_limit: bool = param(
         True, help="ours (diff-drive robot online, velocity space): Algorithm 2's escape is "
                    "given up after 2 x stall_steps moves that have not reached its target, "

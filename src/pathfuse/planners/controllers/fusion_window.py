@@ -248,7 +248,7 @@ class ForceWindow:
                                                                     False))
         """Ours (the fusion's ``walker_escape``): ``dwa``'s lane escape on the sequences'
         command (:func:`~pathfuse.planners.controllers.dwa_escape.escape_command`)."""
-        self.walker_escape_s = float(p.lane_escape_s)
+        self.walker_escape_s = float(getattr(sp, "walker_escape_s", p.lane_escape_s))
         self.walker_escape_hold = float(getattr(sp, "walker_escape_hold", 5.0))
         self.walker_escapes = 0
         """Ticks whose command the walker escape replaced."""

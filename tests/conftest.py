@@ -10,8 +10,7 @@ import pytest
 from pathfuse.planners import registry
 
 
-@pytest.fixture(autouse=True)
-def _restore_planner_registry():
+def _kept_registry():
     registry.planner_names()  # make sure the built-in planners are loaded first
     tables = (registry.REGISTRY, registry._ALIASES, registry.GLOBAL_PLANNERS,
               registry.CONTROLLERS)
@@ -21,3 +20,15 @@ def _restore_planner_registry():
         table.clear()
         table.update(old)
     registry._DEFAULTS.clear()
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _restore_planner_registry_per_module():
+    """A module-scoped fixture (a study run once for a module's tests) registers before
+    any test's own snapshot is taken: the module's end restores the registry too."""
+    yield from _kept_registry()
+
+
+@pytest.fixture(autouse=True)
+def _restore_planner_registry():
+    yield from _kept_registry()

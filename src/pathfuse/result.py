@@ -257,11 +257,13 @@ class PlanResult:
 
     @classmethod
     def _made(cls, status: Status, path: np.ndarray, length: float, time_s: float,
-              planner: str, expansions: int, iterations: int, message: str,
+              planner: str, expansions: int, iterations: int, message: str | None,
               info: dict[str, Any]) -> PlanResult:
         """``cls(...)`` with every field given: stored as the frozen dataclass's ``__init__``
         stores them, without its ``object.__setattr__`` call per field (about 1 us of a
-        tiny ``plan()``'s 17 us; :func:`pathfuse.planners.run.solve` builds its results so)."""
+        tiny ``plan()``'s 17 us; :func:`pathfuse.planners.run.solve` builds its results so).
+        ``message`` None leaves it to the class: a :class:`_FoundPath` writes it on first
+        read."""
         obj = object.__new__(cls)
         d = obj.__dict__
         d["status"] = status
@@ -271,7 +273,8 @@ class PlanResult:
         d["planner"] = planner
         d["expansions"] = expansions
         d["iterations"] = iterations
-        d["message"] = message
+        if message is not None:
+            d["message"] = message
         d["info"] = info
         return obj
 
@@ -337,23 +340,6 @@ class _FoundPath(PlanResult):
     """
 
     message = _FoundMessage()  # type: ignore[assignment]
-
-    @classmethod
-    def _made(cls, status: Status, path: np.ndarray, length: float, time_s: float,
-              planner: str, expansions: int, iterations: int, message: str | None,
-              info: dict[str, Any]) -> PlanResult:
-        """:meth:`PlanResult._made` without the message (``message`` is ignored)."""
-        obj = object.__new__(cls)
-        d = obj.__dict__
-        d["status"] = status
-        d["path"] = path
-        d["length"] = length
-        d["time_s"] = time_s
-        d["planner"] = planner
-        d["expansions"] = expansions
-        d["iterations"] = iterations
-        d["info"] = info
-        return obj
 
     def __reduce__(self) -> Any:
         return (PlanResult._made, (self.status, self.path, self.length, self.time_s,

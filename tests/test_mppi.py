@@ -245,3 +245,17 @@ def test_lane_escape_scores_against_the_current_path(dwell_s):
     assert ctrl.f.seg_max_m == pytest.approx(6.0) != first
     assert ctrl.f_escape.seg_max_m == ctrl.f.seg_max_m
     assert ctrl.f_escape.dwell_s == max(dwell_s, ESCAPE_DWELL_S)
+
+
+def test_track_from_the_last_point_reads_only_the_path():
+    """``_track`` asked from the path's last point takes its last segment; it read the
+    point after the last before (out of bounds, unchecked in compiled code), which its
+    source run by CPython shows as an IndexError."""
+    from pathfuse.planners.controllers.mppi_kernel import _track
+
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.5]])
+    cum = np.array([0.0, 1.0, 1.0 + np.hypot(1.0, 0.5)])
+    for j in (1, 2):
+        got = _track.py_func(2.1, 0.4, pts, cum, j, 0, 5.0, 5.0)  # its source, bounds checked
+        assert got == _track(2.1, 0.4, pts, cum, j, 0, 5.0, 5.0)
+        assert got[0] == 1 and got[2] == 1.0  # the last segment, at its end

@@ -203,6 +203,8 @@ def _track(px, py, pts, cum, j, k0, fwd, back):
     m = pts.shape[0]
     if m == 1:
         return 0, math.hypot(px - pts[0, 0], py - pts[0, 1]), 0.0
+    if j > m - 2:  # past the last segment's start: the last segment (segment m - 1 would
+        j = m - 2  # read pts[m], past the end, found by running the kernel interpreted)
     lo = j
     while lo > k0 and cum[j] - cum[lo - 1] <= back:
         lo -= 1

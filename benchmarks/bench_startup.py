@@ -10,7 +10,12 @@ the folder of the cold run before it.
 * ``help``: ``pathfuse --help``;
 * ``numba``: ``import numba`` and a first compilation (of a one-line function): numba's
   own start-up, which every first plan pays;
-* ``plan-<planner>``: ``pathfuse plan --map paper --planner <planner>``, cold and warm.
+* ``plan-<planner>``: ``pathfuse plan --map paper --planner <planner>``: ``cold`` on an
+  empty cache under the default rule (``PATHFUSE_KERNELS`` unset: a small map's plan runs
+  its kernels interpreted, :mod:`pathfuse.tier`), ``compile`` on an empty cache with
+  ``PATHFUSE_KERNELS=compiled`` (what compiling the kernels costs), and ``warm`` with the
+  kernels in the cache (the folder of the ``compile`` run before it; the default rule then
+  runs them compiled).
 
 pathfuse's modules are byte-compiled first (:func:`byte_compile`), as an installed
 package's are, so no run pays for compiling Python sources.
@@ -97,16 +102,19 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     out["numba"] = summary([run([sys.executable, "-c", NUMBA_FLOOR]) for _ in range(args.runs)])
     for planner in args.planners:
         cmd = [*PATHFUSE, "plan", "--map", "paper", "--planner", planner]
-        cold, warm = [], []
+        cold, compiled, warm = [], [], []
+        base = {k: v for k, v in os.environ.items() if k != "PATHFUSE_KERNELS"}
         for _ in range(args.cold_runs):
             cache = tempfile.mkdtemp(prefix="pathfuse-numba-")
-            env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+            env = {**base, "NUMBA_CACHE_DIR": cache}
             try:
-                cold.append(run(cmd, env))
+                cold.append(run(cmd, env))  # interpreted: leaves the cache empty
+                compiled.append(run(cmd, {**env, "PATHFUSE_KERNELS": "compiled"}))
                 warm.extend(run(cmd, env) for _ in range(max(1, args.runs // args.cold_runs)))
             finally:
                 shutil.rmtree(cache, ignore_errors=True)
-        out[f"plan-{planner}"] = {"cold": summary(cold), "warm": summary(warm)}
+        out[f"plan-{planner}"] = {"cold": summary(cold), "compile": summary(compiled),
+                                  "warm": summary(warm)}
     out["load_end"] = round(os.getloadavg()[0], 2)
     m = out["machine"]
     print(f"machine: {m['machine']}, {m['cores']} cores, load average {m['load']} at the start, "
@@ -115,9 +123,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         s = out[key]
         print(f"{key:<14} CPU {s['cpu_s']:.3f} s, wall {s['wall_s']:.3f} s (median of {s['runs']})")
     for planner in args.planners:
-        for kind in ("cold", "warm"):
+        for kind in ("cold", "compile", "warm"):
             s = out[f"plan-{planner}"][kind]
-            print(f"plan {planner:<9} {kind}: CPU {s['cpu_s']:.2f} s (min {s['cpu_min_s']:.2f}, "
+            print(f"plan {planner:<9} {kind:<7}: CPU {s['cpu_s']:.2f} s (min {s['cpu_min_s']:.2f}, "
                   f"max {s['cpu_max_s']:.2f}), wall {s['wall_s']:.2f} s, {s['runs']} runs")
     if args.json:
         args.json.write_text(json.dumps(out, indent=1) + "\n")

@@ -215,13 +215,18 @@ def render_startup(r: dict[str, Any]) -> str:
            f"| `python -c \"import pathfuse\"` | {r['import']['cpu_s']:.2f} s | "
            f"{r['import']['wall_s']:.2f} s |",
            f"| `pathfuse --help` | {r['help']['cpu_s']:.2f} s | {r['help']['wall_s']:.2f} s |"]
+    kinds = {"cold": "cold cache (kernels interpreted)",
+             "compile": "cold cache, `PATHFUSE_KERNELS=compiled` (kernels compiled)",
+             "warm": "warm cache (kernels loaded)"}
     for key in r:
         if key.startswith("plan-"):
-            for kind in ("cold", "warm"):
+            for kind, said in kinds.items():
+                if kind not in r[key]:
+                    continue
                 s = r[key][kind]
                 span = (f" ({s['cpu_min_s']:.1f}–{s['cpu_max_s']:.1f})"
-                        if kind == "cold" and s["runs"] > 1 else "")
-                out.append(f"| `pathfuse plan --map paper --planner {key[5:]}`, {kind} cache "
+                        if kind != "warm" and s["runs"] > 1 else "")
+                out.append(f"| `pathfuse plan --map paper --planner {key[5:]}`, {said} "
                            f"| {s['cpu_s']:.2f} s{span} | {s['wall_s']:.2f} s |")
     if "numba" in r:
         n = r["numba"]

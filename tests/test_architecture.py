@@ -17,7 +17,8 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "pathfuse"
 
 # low -> high; a module may import its own layer and the layers below it
 LAYERS: list[tuple[str, ...]] = [
-    ("_version", "result", "validate", "limits", "safeyaml", "shipped", "datasets", "sigterm"),
+    ("_version", "result", "validate", "limits", "safeyaml", "shipped", "datasets", "sigterm",
+     "tier"),
     ("grid", "geometry", "problem", "stats", "robot", "sweep", "costmap", "shield"),
     ("search", "field", "io", "generate", "metrics", "metrics_kernels"),
     ("planners", "api"),

@@ -51,8 +51,12 @@ def test_a_static_plan_compiles_only_what_it_runs():
             "print(len(_astar_ring.signatures), len(_astar_radix.signatures),\n"
             "      len(k.field_loop.signatures))\n"
             "print('scipy.ndimage' in sys.modules)\n")
+    import os
+
+    # compiled: were the cache cold, the plan would run its kernels interpreted
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True, timeout=600)
+                         check=True, timeout=600,
+                         env={**os.environ, "PATHFUSE_KERNELS": "compiled"})
     assert out.stdout.split("\n")[:3] == ["[['none', 'none', 'none', 'omitted(default=None)']]",
                                         "1 0 0", "False"], \
         out.stdout

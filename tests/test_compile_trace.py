@@ -14,7 +14,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_trace_of_a_cold_astar_plan(tmp_path):
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    # compiled: on an empty cache a plan on the paper map runs its kernels interpreted
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "PATHFUSE_KERNELS": "compiled"}
     out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "compile_trace.py"), "plan",
                           "--map", "paper", "--planner", "astar"], capture_output=True,
                          text=True, env=env, check=True, timeout=600).stdout

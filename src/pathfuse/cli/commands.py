@@ -42,7 +42,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if args.plot:
         args.plot = output_file(args.plot, "--plot", ".png")
     budget = pathfuse.Budget(time_limit_s=args.time_limit) if args.time_limit else None
-    _warm_query(args.planner, params, args.robot_radius)
+    _warm_query(args.planner, params, args.robot_radius, grid.occupied.size)
     result, spec, cfg, _ = plan_query(grid, start, goal, args.planner, params, budget=budget,
                                       robot_radius_m=args.robot_radius)
     global_planner = spec.global_planner_of(cfg)
@@ -59,6 +59,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
         d["map"] = grid.name
         d["start"], d["goal"] = list(start), list(goal)
         d["global_planner"] = global_planner
+        d["kernels"] = result.info.get("kernels", "compiled")
         print(json.dumps(d))
     else:
         print(f"map       {grid.name}  ({grid.width} x {grid.height} cells, {grid.resolution:g} m)")
@@ -66,7 +67,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
         print(f"planner   {result.planner}{also}")
         print(f"status    {result.status.name}  {result.message}")
         print(f"length    {result.length:.4f} m  ({len(result.path)} points)")
-        print(f"time      {result.time_s * 1e3:.3f} ms")
+        how = ("  (kernels interpreted: not compiled yet; see PATHFUSE_KERNELS)"
+               if result.info.get("kernels") == "interpreted" else "")
+        print(f"time      {result.time_s * 1e3:.3f} ms{how}")
         if result.expansions:
             print(f"expanded  {result.expansions}")
         if result.iterations:
@@ -135,9 +138,11 @@ def _warm_with_notice(planner: str | Sequence[str], world: bool = False) -> None
     warm_kernels(names, metrics=False, world=world, notify=notice)
 
 
-def _warm_query(planner: str, params: dict[str, Any], robot_radius_m: float) -> None:
+def _warm_query(planner: str, params: dict[str, Any], robot_radius_m: float,
+                cells: int) -> None:
     """Compile the kernels one plan runs (its global planner's and controller's only),
-    saying so first, in one line, when numba's cache is cold."""
+    saying so first, in one line, when numba's cache is cold; nothing when the plan, on a
+    map of ``cells`` cells, runs them interpreted (:mod:`pathfuse.tier`)."""
     from pathfuse.planners.registry import get_planner, make_params
     from pathfuse.planners.run import warm_query
 
@@ -146,7 +151,7 @@ def _warm_query(planner: str, params: dict[str, Any], robot_radius_m: float) -> 
               "afterwards)", file=sys.stderr, flush=True)
 
     spec = get_planner(planner)
-    warm_query(spec, make_params(spec, params), robot_radius_m, notice)
+    warm_query(spec, make_params(spec, params), robot_radius_m, notice, cells=cells)
 
 
 def with_global_planner(params: dict[str, Any], name: str | None) -> dict[str, Any]:

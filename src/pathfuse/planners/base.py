@@ -42,12 +42,14 @@ from pathfuse.field.settings import DiscSettings, FieldSettings, FusionSettings,
 from pathfuse.limits import LimitError, env_name, limit
 from pathfuse.problem import Problem
 from pathfuse.result import Status
+from pathfuse.tier import interpreting
 
 __all__ = ["Outcome", "Controller", "FieldController", "Observed", "CHUNK", "CAP_FACTOR",
            "STALL_FRAC", "sensed_discs"]
 
 #: Moves per numba call between wall-clock checks when a time limit is set.
 CHUNK = 8192
+_INTERPRETED_CHUNK = 512  # steps of one interpreted call: some 0.1 s
 #: Default move cap: this many times (width + height) / step, plus 1000.
 CAP_FACTOR = 10.0
 #: Default stall distance, in moves.
@@ -432,6 +434,8 @@ class FieldController(Controller):
         while True:
             left = self.max_steps - total
             chunk = left if deadline is None else min(CHUNK, left)
+            if interpreting():  # kernels run interpreted (pathfuse.tier): its budget is
+                chunk = min(_INTERPRETED_CHUNK, left)  # checked between calls
             code, steps = self._call(chunk, *STATIC)  # no disc code compiled
             total += steps
             if code != CODE_RUNNING or total >= self.max_steps:

@@ -20,12 +20,14 @@ from typing import Any
 
 import numpy as np
 
+from pathfuse import tier
 from pathfuse.grid import GridMap
 from pathfuse.metrics import PlanInfo
 from pathfuse.planners.base import Controller, Observed
 from pathfuse.planners.globals.astar import GlobalPlan, searched
 from pathfuse.planners.globals.builtin import _astar as _builtin_astar
 from pathfuse.planners.globals.builtin import run_global
+from pathfuse.planners.kernel_cache import cold_kernels, is_cached
 from pathfuse.planners.registry import GLOBAL_PLANNERS, PlannerSpec, make_params
 from pathfuse.problem import _DEFAULT_BUDGET, Problem
 from pathfuse.result import Budget, ConfigError, PlanResult, Status, _FoundPath, path_length
@@ -62,8 +64,7 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
         if segments and not _WARM_SEGMENT:
             _warm_segments()
         return
-    from pathfuse.planners.kernel_cache import cold_kernels
-
+    tier.stop()  # compiling on purpose: no plan of this process runs interpreted from now
     if notify is not None and cold_kernels(spec, params=params, diff_drive=diff_drive,
                                            online=online):
         notify()
@@ -86,9 +87,22 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
 
 
 def warm_query(spec: PlannerSpec, params: Any, robot_radius_m: float,
-               notify: Callable[[], None] | None = None) -> None:
-    """:func:`warm` for one offline plan of ``spec`` (what :func:`solve` warms)."""
-    warm(spec, notify, params=params, segments=_needs_segments(spec, robot_radius_m))
+               notify: Callable[[], None] | None = None, *, cells: int | None = None) -> None:
+    """:func:`warm` for one offline plan of ``spec`` (what :func:`solve` warms), unless
+    the plan, on a map of ``cells`` cells (when given), will run its kernels interpreted
+    (:mod:`pathfuse.tier`)."""
+    segments = _needs_segments(spec, robot_radius_m)
+    if cells is not None and _interprets(spec, params, cells, segments):
+        return
+    warm(spec, notify, params=params, segments=segments)
+
+
+def _interprets(spec: PlannerSpec, params: Any, cells: int, segments: bool) -> bool:
+    """Whether an offline plan of ``spec`` on a map of ``cells`` cells runs its kernels
+    interpreted (:func:`pathfuse.tier.admit`; a planner given as a function compiles)."""
+    return spec.function is None and tier.admit(
+        cells, lambda: bool(cold_kernels(spec, params=params)) or
+        (segments and not _segments_cached()))
 
 
 def _needs_segments(spec: PlannerSpec, robot_radius_m: float) -> bool:
@@ -97,6 +111,14 @@ def _needs_segments(spec: PlannerSpec, robot_radius_m: float) -> bool:
     returns the global path as planned)."""
     ctrl = spec.controller
     return robot_radius_m > 0 or ctrl is None or not ctrl.search_budget
+
+
+def _segments_cached() -> bool:
+    """Whether :func:`_warm_segments`' kernels are in numba's on-disk cache."""
+    from pathfuse.costmap import move_clear
+    from pathfuse.geometry import segment_is_clear
+
+    return is_cached(move_clear) and is_cached(segment_is_clear)
 
 
 def _warm_segments() -> None:
@@ -128,18 +150,39 @@ def _astar_info(gp: GlobalPlan | None) -> dict[str, Any]:
 
 def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     """Plan ``problem`` with ``spec`` offline (the body of :func:`pathfuse.plan`)."""
-    bad = problem.failure()
-    if bad is not None:
-        return PlanResult(bad[0], planner=spec.name, message=bad[1])
     gname = getattr(params, "global_planner", None) or spec.global_planner  # global_planner_of
     ctrl_cls = spec.controller
     # _needs_segments, written out
     segments = problem.robot_radius_m > 0 or ctrl_cls is None or not ctrl_cls.search_budget
     margin = problem.clearance_m > 0
     if (spec.name, gname, False, False, margin, getattr(params, "heuristic", None)) \
-            not in _WARM or \
-            (segments and not _WARM_SEGMENT):  # warm()'s own test, without its call
-        warm(spec, params=params, segments=segments, margin=margin)
+            in _WARM and not (segments and not _WARM_SEGMENT):  # warm()'s own test
+        return _solved(spec, problem, params, gname, ctrl_cls)
+    if _interprets(spec, params, problem.grid.occupied.size, segments):
+        try:
+            with tier.running(True):
+                res = _solved(spec, problem, params, gname, ctrl_cls)
+            res.info["kernels"] = "interpreted"
+            return res
+        except Exception:  # noqa: BLE001 - the budget ran out, or a kernel's Python
+            # semantics differ from numba's (tests/test_tier.py holds them equal on every
+            # planner): the plan again, compiled, as without pathfuse.tier
+            if tier.mode() == "interpreted":
+                raise
+    return _solved(spec, problem, params, gname, ctrl_cls, (segments, margin))
+
+
+def _solved(spec: PlannerSpec, problem: Problem, params: Any, gname: str | None,
+            ctrl_cls: type[Controller] | None,
+            warm_first: tuple[bool, bool] | None = None) -> PlanResult:
+    """:func:`solve` once its kernels are warm or run interpreted, or, with
+    ``warm_first`` (``segments`` and ``margin`` of :func:`warm`), after warming them (a
+    query that fails its checks warms nothing)."""
+    bad = problem.failure()
+    if bad is not None:
+        return PlanResult(bad[0], planner=spec.name, message=bad[1])
+    if warm_first is not None:
+        warm(spec, params=params, segments=warm_first[0], margin=warm_first[1])
     budget = problem.budget
     if spec.function is not None:
         res = spec.function(problem.grid, np.array(problem.start), np.array(problem.goal),

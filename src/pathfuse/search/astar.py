@@ -98,6 +98,7 @@ from pathfuse.search.kernel import (
     _astar_radix,
     _astar_ring,
 )
+from pathfuse.tier import interpreting
 from pathfuse.validate import short as _shown
 
 __all__ = [
@@ -350,6 +351,8 @@ class AStarSearcher(_Regions):
             self._closed_gen = gen + 1
             kernel = _KERNEL_ENTRY["octile" if heuristic == "octile" else "euclidean"]
             chunk = _CHUNK if time_limit_s is not None else budget
+            if interpreting():  # kernels run interpreted (pathfuse.tier): its budget is
+                chunk = min(chunk, 4096)  # checked between calls (some 0.1 s apart)
             done = 0
             first = start
             ox, oy, res = origin

@@ -224,8 +224,8 @@ def _jps_kernel(free, rows, cols, nwr, nwc, gbuf, stamp, parent, hkey, hnode, me
         else:
             rr = p // wp - pp // wp
             cc = (p - (p // wp) * wp) - (pp - (pp // wp) * wp)
-            ddy = (rr > 0) - (rr < 0)
-            ddx = (cc > 0) - (cc < 0)
+            ddy = int(rr > 0) - int(rr < 0)  # int(): numpy's bools do not subtract (pathfuse.tier)
+            ddx = int(cc > 0) - int(cc < 0)
         for k in range(8):
             # candidate direction (dy, dx) of this successor
             if k == 0:
@@ -319,8 +319,8 @@ def _jps_trace(parent, start, goal, wp, ox, oy, res):
             break
         q = parent[p]
         qr, qc = q // wp, q - (q // wp) * wp
-        sr = (qr > r) - (qr < r)
-        sc = (qc > c) - (qc < c)
+        sr = int(qr > r) - int(qr < r)
+        sc = int(qc > c) - int(qc < c)
         k = max(abs(r - qr), abs(c - qc))
         if sr != 0 and sc != 0:
             diagonal += k

@@ -13,6 +13,7 @@ from numba import njit, types
 from numba.extending import intrinsic
 
 from pathfuse.result import CODE_GROW, CODE_NO_PATH, CODE_RUNNING, CODE_SUCCESS
+from pathfuse.tier import python_for
 
 _CHUNK = 1 << 16  # expansions between clock checks when a time limit is set
 _RING_SCALE = 1024.0  # ring buckets per cell of f (euclidean open list)
@@ -35,6 +36,11 @@ def _bit_length(typingctx, x):
     return sig, codegen
 
 
+@python_for(_bit_length)
+def _bit_length_py(x: np.uint64) -> int:
+    return int(x).bit_length()
+
+
 @intrinsic
 def _bits_of(typingctx, x):
     """The IEEE-754 bits of a float64, as uint64 (an LLVM bitcast: no memory round trip)."""
@@ -44,6 +50,11 @@ def _bits_of(typingctx, x):
         return builder.bitcast(args[0], ir.IntType(64))
 
     return sig, codegen
+
+
+@python_for(_bits_of)
+def _bits_of_py(x: float) -> np.uint64:
+    return np.float64(x).view(np.uint64)  # type: ignore[no-any-return]
 
 
 @intrinsic
@@ -73,6 +84,11 @@ def _fetch(typingctx, cell, gbuf, q, uw):
         return context.get_dummy_value()
 
     return sig, codegen
+
+
+@python_for(_fetch)
+def _fetch_py(cell: Any, gbuf: Any, q: Any, uw: Any) -> None:
+    """A prefetch only hints the cache: nothing to do in the interpreter."""
 
 
 @njit(cache=True, nogil=True)
@@ -117,6 +133,12 @@ def _trailing_zeros(typingctx, x):
         return builder.cttz(args[0], ir.Constant(ir.IntType(1), 0))
 
     return sig, codegen
+
+
+@python_for(_trailing_zeros)
+def _trailing_zeros_py(x: np.uint64) -> int:
+    v = int(x)
+    return (v & -v).bit_length() - 1
 
 
 @njit(cache=True, nogil=True)

@@ -228,3 +228,18 @@ def test_a_twin_compiles_nothing_and_an_unknown_intrinsic_is_named():
         tier.interpreted(uses)
     assert uses not in tier._TWINS
     assert uses.signatures == []
+
+
+def test_the_docs_state_the_rule_s_constants():
+    """The map size and the budget the pages give are the module's."""
+    from pathlib import Path
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    side = int(np.sqrt(tier.MAX_CELLS))
+    assert side * side == tier.MAX_CELLS
+    speed = (docs / "speed.md").read_text()
+    arch = (docs / "architecture.md").read_text()
+    for text in (speed, arch, (docs / "getting-started.md").read_text()):
+        assert f"{side} × {side} cells" in " ".join(text.split())
+    assert f"{tier.BUDGET_S:g} s of CPU" in " ".join(arch.split())
+    assert f"`tier.BUDGET_S = {tier.BUDGET_S}`" in " ".join(speed.split())

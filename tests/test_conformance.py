@@ -16,6 +16,7 @@ import dataclasses
 import math
 import re
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -436,3 +437,66 @@ def test_warm_up_compiles_every_signature_a_plan_uses(tmp_path):
     assert out.returncode == 0, out.stderr[-2000:]
     lines = out.stdout.strip().splitlines()
     assert lines == [] or lines == [""], f"kernels compiled after the warm-up: {lines}"
+
+
+_NO_COMPILE_IN_A_DECISION = r"""
+import sys
+import traceback
+from pathlib import Path
+from numba.core.dispatcher import Dispatcher
+import pathfuse
+import pathfuse.tier  # its hook first: the spy below wraps it
+from pathfuse.robot import RobotModel
+
+timed = []
+numba_compile = Dispatcher._compile_for_args
+
+def spy(self, *args, **kws):
+    # numba found no code of this kernel for these types in the process (or its fast path
+    # matched none): a new overload is a compile or a load from its cache; inside
+    # Controller.command, the episode's timed decision (not the warm-up episode's)
+    before = len(self.overloads)
+    out = numba_compile(self, *args, **kws)
+    stack = traceback.extract_stack()
+    if len(self.overloads) > before and \
+            any(f.name == "command" and f.filename.endswith("planners/base.py") for f in stack) \
+            and not any(f.name == "_warm_episode" for f in stack):
+        timed.append(CURRENT[0] + ": " + self.py_func.__qualname__)
+    return out
+
+Dispatcher._compile_for_args = spy
+CURRENT = [""]
+scenario = Path(sys.argv[1])
+robots = {"holonomic": RobotModel(radius_m=0.2, max_speed_mps=1.0, sensing_radius_m=3.0),
+          "diff-drive": RobotModel.diff_drive(radius_m=0.2, max_speed_mps=1.0,
+                                              sensing_radius_m=3.0)}
+n = sys.argv[2]
+for kind, robot in robots.items():
+    CURRENT[0] = f"{n} {kind}"
+    pathfuse.simulate(scenario, planner=n, robot=robot)
+print("\n".join(sorted(set(timed))))
+"""
+
+
+def _online_planners() -> list[str]:
+    from pathfuse.planners.registry import get_planner, planner_names
+
+    return [n for n in planner_names() if get_planner(n).online]
+
+
+@pytest.mark.parametrize("name", _online_planners())
+def test_no_kernel_compiles_inside_an_episode_s_decision(name):
+    """The same for episodes: ``simulate`` warms what its planner runs online (on its
+    robot model) before the first tick, so no tick's decision time holds a compile, among
+    moving discs on either robot model (mppi's lane escape compiled inside the first
+    episode's ticks: a ``max_plan_time_s`` of 5 s)."""
+    import subprocess
+    import sys
+
+    head_on = Path(__file__).resolve().parents[1] / "examples" / "scenarios" / "head_on.yaml"
+    # a process per planner: a kernel another planner loaded first would hide its own gap
+    out = subprocess.run([sys.executable, "-c", _NO_COMPILE_IN_A_DECISION, str(head_on), name],
+                         capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stderr[-2000:]
+    lines = out.stdout.strip().splitlines()
+    assert lines == [], f"compiled inside a decision: {lines}"

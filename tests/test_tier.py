@@ -158,7 +158,8 @@ def test_admit_follows_size_cache_budget_and_mode(fresh_rule, monkeypatch):
         asked.append(1)
         return True
 
-    assert tier.admit(tier.MAX_CELLS, cold)
+    assert not tier.admit(4, cold, timed=True)  # a time limit needs the compiled speed
+    assert tier.admit(tier.MAX_CELLS, cold)  # and did not end interpretation
     assert not tier.admit(tier.MAX_CELLS, lambda: False)  # compiled code is there: stop
     assert not tier.admit(1, cold)  # and the process compiles from then on
     monkeypatch.setattr(tier, "_state", {"on": True, "spent": 0.0})
@@ -171,6 +172,7 @@ def test_admit_follows_size_cache_budget_and_mode(fresh_rule, monkeypatch):
     monkeypatch.setenv("PATHFUSE_KERNELS", " Interpreted ")
     n = len(asked)
     assert tier.admit(10**9, cold) and len(asked) == n  # always, without asking the cache
+    assert tier.admit(4, cold, timed=True)
 
 
 def test_a_bad_pathfuse_kernels_names_the_variable(fresh_rule, monkeypatch):
@@ -243,3 +245,25 @@ def test_the_docs_state_the_rule_s_constants():
         assert f"{side} × {side} cells" in " ".join(text.split())
     assert f"{tier.BUDGET_S:g} s of CPU" in " ".join(arch.split())
     assert f"`tier.BUDGET_S = {tier.BUDGET_S}`" in " ".join(speed.split())
+
+
+TIMED = CASES + r"""
+import pickle, sys
+import pathfuse
+from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map
+
+g = paper_map(0)
+a = pathfuse.plan(g, PAPER_START, PAPER_GOAL, budget=pathfuse.Budget(time_limit_s=60.0))
+b = pathfuse.plan(g, PAPER_START, PAPER_GOAL)
+with open(sys.argv[1], "wb") as f:
+    pickle.dump([(r.info.get("kernels"), outcome(r)) for r in (a, b)], f)
+"""
+
+
+@pytest.mark.slow
+def test_a_plan_with_a_time_limit_compiles(tmp_path):
+    """Interpreted, a time limit could end a plan that compiled code finishes: such a plan
+    compiles (and the process compiles from then on)."""
+    out = _fresh(tmp_path, TIMED, mode="auto")
+    assert [how for how, _ in out] == [None, None]
+    assert out[0][1] == out[1][1] and out[0][1][0] == "SUCCESS"

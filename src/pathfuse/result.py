@@ -229,7 +229,9 @@ class PlanResult:
         Length of ``path`` in metres (sum of segment lengths).
     time_s : float
         Wall-clock planning time in seconds (numba compilation excluded: the
-        kernels are compiled and cached before timing starts).
+        kernels are compiled and cached before timing starts, or the plan ran
+        them interpreted, as ``info["kernels"]`` then says: see
+        :mod:`pathfuse.tier`).
     planner : str
         Registry name of the planner.
     expansions : int
@@ -239,7 +241,8 @@ class PlanResult:
     message : str
         A human sentence about the outcome.
     info : dict
-        Planner-specific extras (for example the A* global path of fusion).
+        Planner-specific extras (for example the A* global path of fusion);
+        ``"kernels": "interpreted"`` when the plan ran its kernels interpreted.
     """
 
     status: Status
@@ -295,7 +298,8 @@ class PlanResult:
         return self
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-ready dict (path as a list of ``[x, y]``)."""
+        """A JSON-ready dict (path as a list of ``[x, y]``; ``kernels``: how the kernels ran,
+        ``"interpreted"`` or ``"compiled"``, see :mod:`pathfuse.tier`)."""
         import numpy as np
 
         return {
@@ -307,6 +311,7 @@ class PlanResult:
             "iterations": int(self.iterations),
             "message": self.message,
             "path": np.asarray(self.path, dtype=float).tolist(),
+            "kernels": self.info.get("kernels", "compiled"),
         }
 
 

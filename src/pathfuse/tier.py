@@ -12,8 +12,12 @@ and numba's intrinsics replaced by Python functions registered beside them
 bit (``tests/test_tier.py`` holds them equal); only the time differs.
 
 The rule (``auto``, the default) is a ski rental: rent (interpret) until the
-rent paid would buy (compile).  :func:`admit` lets a plan run interpreted when
+rent paid would buy (compile).  :func:`admit`, asked by
+:func:`pathfuse.planners.run.solve` before each plan whose kernels are not warm in
+the process, lets the plan run interpreted when
 
+* the plan has no time limit (an interpreted plan is tens of times slower: with a
+  limit, its outcome could differ),
 * the map has at most :data:`MAX_CELLS` cells (a search interpreted expands
   every cell at worst: this bounds what one plan can cost),
 * some kernel it runs is neither compiled in this process nor in numba's cache
@@ -23,7 +27,10 @@ rent paid would buy (compile).  :func:`admit` lets a plan run interpreted when
 
 Past the budget, on a larger map, or once anything in the process compiles
 (:func:`stop`: a study, a simulation, :func:`pathfuse.planners.run.warm`),
-everything runs compiled, as before; a plan never switches halfway.  The
+everything runs compiled, as before.  A plan never mixes the two: one that runs
+out of budget halfway (:class:`OverBudget`, checked at each call from Python
+into a kernel: the searches and the stepping loops are called in chunks while
+interpreted) starts again compiled.  The
 environment variable ``PATHFUSE_KERNELS`` sets the rule: ``auto``, ``compiled``
 (always compile: timings comparable with a warm cache) or ``interpreted``
 (never compile what this module covers: a debugger steps through the kernels'
@@ -92,17 +99,18 @@ def mode() -> str:
     return value
 
 
-def admit(cells: int, cold: Callable[[], bool]) -> bool:
-    """Whether the plan about to start, on a map of ``cells`` cells, runs its kernels
-    interpreted.  ``cold()`` tells whether some kernel it runs still needs compiling (it
-    is called only when the answer depends on it).  A plan that is not admitted under
-    ``auto`` ends interpretation for the process (:func:`stop`)."""
+def admit(cells: int, cold: Callable[[], bool], *, timed: bool = False) -> bool:
+    """Whether the plan about to start, on a map of ``cells`` cells (with a time limit
+    when ``timed``), runs its kernels interpreted.  ``cold()`` tells whether some kernel
+    it runs still needs compiling (it is called only when the answer depends on it).  A
+    plan that is not admitted under ``auto`` ends interpretation for the process
+    (:func:`stop`), except for its time limit alone."""
     rule = mode()
     if _NUMBA_COMPILE is None:
         return False
     if rule == "interpreted":
         return True
-    if rule == "compiled" or not _state["on"]:
+    if rule == "compiled" or not _state["on"] or timed:
         return False
     if cells <= MAX_CELLS and _state["spent"] < BUDGET_S and cold():
         return True

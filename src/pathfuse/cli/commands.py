@@ -42,7 +42,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if args.plot:
         args.plot = output_file(args.plot, "--plot", ".png")
     budget = pathfuse.Budget(time_limit_s=args.time_limit) if args.time_limit else None
-    _warm_query(args.planner, params, args.robot_radius, grid.occupied.size)
+    _warm_query(args.planner, params, args.robot_radius, grid.occupied.size,
+                budget is not None)
     result, spec, cfg, _ = plan_query(grid, start, goal, args.planner, params, budget=budget,
                                       robot_radius_m=args.robot_radius)
     global_planner = spec.global_planner_of(cfg)
@@ -59,7 +60,6 @@ def cmd_plan(args: argparse.Namespace) -> int:
         d["map"] = grid.name
         d["start"], d["goal"] = list(start), list(goal)
         d["global_planner"] = global_planner
-        d["kernels"] = result.info.get("kernels", "compiled")
         print(json.dumps(d))
     else:
         print(f"map       {grid.name}  ({grid.width} x {grid.height} cells, {grid.resolution:g} m)")
@@ -139,10 +139,11 @@ def _warm_with_notice(planner: str | Sequence[str], world: bool = False) -> None
 
 
 def _warm_query(planner: str, params: dict[str, Any], robot_radius_m: float,
-                cells: int) -> None:
+                cells: int, timed: bool) -> None:
     """Compile the kernels one plan runs (its global planner's and controller's only),
     saying so first, in one line, when numba's cache is cold; nothing when the plan, on a
-    map of ``cells`` cells, runs them interpreted (:mod:`pathfuse.tier`)."""
+    map of ``cells`` cells and without a time limit (not ``timed``), runs them interpreted
+    (:mod:`pathfuse.tier`)."""
     from pathfuse.planners.registry import get_planner, make_params
     from pathfuse.planners.run import warm_query
 
@@ -151,7 +152,8 @@ def _warm_query(planner: str, params: dict[str, Any], robot_radius_m: float,
               "afterwards)", file=sys.stderr, flush=True)
 
     spec = get_planner(planner)
-    warm_query(spec, make_params(spec, params), robot_radius_m, notice, cells=cells)
+    warm_query(spec, make_params(spec, params), robot_radius_m, notice, cells=cells,
+               timed=timed)
 
 
 def with_global_planner(params: dict[str, Any], name: str | None) -> dict[str, Any]:

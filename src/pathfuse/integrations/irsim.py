@@ -443,8 +443,9 @@ class IrsimController:
                  sensing_radius_m: float = DEFAULT_SENSING_RADIUS_M,
                  robot_overrides: Mapping[str, Any] | None = None, **params: Any) -> None:
         from pathfuse.planners.registry import get_planner, make_params
-        from pathfuse.planners.run import Stopped, start_online, warm
+        from pathfuse.planners.run import Stopped, start_online
         from pathfuse.problem import Problem
+        from pathfuse.world.episode import warm_online
 
         spec = get_planner(planner)
         if not spec.online:
@@ -458,16 +459,9 @@ class IrsimController:
         model = sc.robot
         self.problem = Problem.create(sc.grid, sc.start, sc.goal, model.radius_m,
                                       clearance_m=model.clearance_m, robot=model)
-        warm(spec, online=True)
-        from pathfuse.shield import warmup_shield
-
-        warmup_shield()
-        if model.is_diff_drive:
-            from pathfuse.planners.drive import warmup_drive
-            from pathfuse.sweep import warmup_sweep
-
-            warmup_drive()
-            warmup_sweep()
+        # what a pathfuse episode warms (the robot model's kernels, the shield, a warm-up
+        # episode among discs), so that no IR-SIM step's decision holds a compile
+        warm_online(spec, model, cfg)
         bad = self.problem.failure()
         t0 = time.perf_counter()
         self.controller: Controller

@@ -87,22 +87,25 @@ def warm(spec: PlannerSpec, notify: Callable[[], None] | None = None, *, params:
 
 
 def warm_query(spec: PlannerSpec, params: Any, robot_radius_m: float,
-               notify: Callable[[], None] | None = None, *, cells: int | None = None) -> None:
+               notify: Callable[[], None] | None = None, *, cells: int | None = None,
+               timed: bool = False) -> None:
     """:func:`warm` for one offline plan of ``spec`` (what :func:`solve` warms), unless
-    the plan, on a map of ``cells`` cells (when given), will run its kernels interpreted
-    (:mod:`pathfuse.tier`)."""
+    the plan, on a map of ``cells`` cells (when given) and without a time limit (not
+    ``timed``), will run its kernels interpreted (:mod:`pathfuse.tier`)."""
     segments = _needs_segments(spec, robot_radius_m)
-    if cells is not None and _interprets(spec, params, cells, segments):
+    if cells is not None and _interprets(spec, params, cells, segments, timed):
         return
     warm(spec, notify, params=params, segments=segments)
 
 
-def _interprets(spec: PlannerSpec, params: Any, cells: int, segments: bool) -> bool:
-    """Whether an offline plan of ``spec`` on a map of ``cells`` cells runs its kernels
-    interpreted (:func:`pathfuse.tier.admit`; a planner given as a function compiles)."""
+def _interprets(spec: PlannerSpec, params: Any, cells: int, segments: bool,
+                timed: bool) -> bool:
+    """Whether an offline plan of ``spec`` on a map of ``cells`` cells, with a time limit
+    when ``timed``, runs its kernels interpreted (:func:`pathfuse.tier.admit`; a planner
+    given as a function compiles)."""
     return spec.function is None and tier.admit(
         cells, lambda: bool(cold_kernels(spec, params=params)) or
-        (segments and not _segments_cached()))
+        (segments and not _segments_cached()), timed=timed)
 
 
 def _needs_segments(spec: PlannerSpec, robot_radius_m: float) -> bool:
@@ -158,7 +161,8 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     if (spec.name, gname, False, False, margin, getattr(params, "heuristic", None)) \
             in _WARM and not (segments and not _WARM_SEGMENT):  # warm()'s own test
         return _solved(spec, problem, params, gname, ctrl_cls)
-    if _interprets(spec, params, problem.grid.occupied.size, segments):
+    if _interprets(spec, params, problem.grid.occupied.size, segments,
+                   problem.budget.time_limit_s is not None):
         try:
             with tier.running(True):
                 res = _solved(spec, problem, params, gname, ctrl_cls)

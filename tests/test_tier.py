@@ -79,7 +79,11 @@ with open(sys.argv[1], "wb") as f:
 
 def _fresh(tmp_path, script, mode="interpreted", args=()):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PATHFUSE_KERNELS": mode}
-    proc = subprocess.run([sys.executable, "-c", script, str(tmp_path / "out.pkl"), *args],
+    # interpreted, any warning is an error: numpy's scalars warn where compiled code is
+    # silent (an overflow, a division by zero), and a user would see them
+    strict = ["-W", "error"] if mode == "interpreted" else []
+    proc = subprocess.run([sys.executable, *strict, "-c", script, str(tmp_path / "out.pkl"),
+                           *args],
                           capture_output=True, text=True, env=env, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     with open(tmp_path / "out.pkl", "rb") as f:

@@ -41,6 +41,19 @@ def cases():
         out.append((name, rnd, (0.5, 0.5), (23.5, 23.5), {}, 0.0, 0.1))
         out.append((name, walled, (0.5, 0.5), (5.5, 2.5), {}, 0.0, 0.0))  # walled in
         out.append((name, walled, (0.5, 0.5), (5.5, 3.5), {}, 0.0, 0.0))  # in a wall
+    # random maps, sizes and densities (some queries without a path), both heuristics and
+    # both corner rules of A*, and the paper's fusion and APF on them
+    import numpy as np
+    rng = np.random.default_rng(21)
+    variants = [("astar", {}), ("astar", {"heuristic": "octile"}),
+                ("astar", {"corner_cutting": True}), ("fusion", {}), ("apf", {}),
+                ("jps", {}), ("thetastar", {})]
+    for seed in range(10):
+        w, h = (int(v) for v in rng.integers(8, 41, 2))
+        g = random_map((w, h), 1.0, density=float(rng.uniform(0.05, 0.4)), seed=seed,
+                       keep_free=[(0.5, 0.5), (w - 0.5, h - 0.5)])
+        for n2, p2 in (variants[seed % len(variants)], variants[(seed + 3) % len(variants)]):
+            out.append((n2, g, (0.5, 0.5), (w - 0.5, h - 0.5), p2, 0.0, 0.0))
     return out
 
 def outcome(r):

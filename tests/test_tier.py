@@ -284,3 +284,34 @@ def test_a_plan_with_a_time_limit_compiles(tmp_path):
     out = _fresh(tmp_path, TIMED, mode="auto")
     assert [how for how, _ in out] == [None, None]
     assert out[0][1] == out[1][1] and out[0][1][0] == "SUCCESS"
+
+
+NOTICE = r"""
+import sys
+from pathfuse import tier
+from pathfuse.cli import main
+
+tier.BUDGET_S = 1e-9  # the budget runs out during the plan (after its first kernel call)
+sys.exit(main(["plan", "--map", "paper", "--planner", "fusion", "--json"]))
+"""
+
+
+@pytest.mark.slow
+def test_a_cli_plan_that_compiles_after_all_says_so_first(tmp_path):
+    """`pathfuse plan` prints no compile notice for a plan it runs interpreted; when the
+    budget runs out halfway and the plan compiles after all, the notice comes then."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    env.pop("PATHFUSE_KERNELS", None)
+    p = subprocess.run([sys.executable, "-c", NOTICE], capture_output=True, text=True,
+                       env=env, timeout=600)
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert p.stderr.splitlines() == ["pathfuse: compiling the kernels of fusion (first run "
+                                     "only; cached afterwards)"], p.stderr
+    import json
+
+    assert json.loads(p.stdout)["kernels"] == "compiled"
+    p = subprocess.run([sys.executable, "-m", "pathfuse.cli", "plan", "--map", "paper",
+                        "--planner", "fusion"], capture_output=True, text=True,
+                       env={**env, "NUMBA_CACHE_DIR": str(tmp_path / "cold")}, timeout=600)
+    assert p.returncode == 0 and p.stderr == "", p.stderr
+    assert "(kernels interpreted: not compiled yet; see PATHFUSE_KERNELS)" in p.stdout

@@ -94,8 +94,15 @@ def warm_query(spec: PlannerSpec, params: Any, robot_radius_m: float,
     ``timed``), will run its kernels interpreted (:mod:`pathfuse.tier`)."""
     segments = _needs_segments(spec, robot_radius_m)
     if cells is not None and _interprets(spec, params, cells, segments, timed):
+        # should the plan end up compiling after all (over the budget), it says so first
+        _NOTICE[:] = [notify] if notify is not None else []
         return
     warm(spec, notify, params=params, segments=segments)
+
+
+#: The notice :func:`warm_query` was given for a plan it left to run interpreted: said by
+#: :func:`solve` if that plan compiles after all.
+_NOTICE: list[Callable[[], None]] = []
 
 
 def _interprets(spec: PlannerSpec, params: Any, cells: int, segments: bool,
@@ -161,6 +168,7 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
     if (spec.name, gname, False, False, margin, getattr(params, "heuristic", None)) \
             in _WARM and not (segments and not _WARM_SEGMENT):  # warm()'s own test
         return _solved(spec, problem, params, gname, ctrl_cls)
+    notify = _NOTICE.pop() if _NOTICE else None
     if _interprets(spec, params, problem.grid.occupied.size, segments,
                    problem.budget.time_limit_s is not None):
         try:
@@ -173,20 +181,21 @@ def solve(spec: PlannerSpec, problem: Problem, params: Any) -> PlanResult:
             # planner): the plan again, compiled, as without pathfuse.tier
             if tier.mode() == "interpreted":
                 raise
-    return _solved(spec, problem, params, gname, ctrl_cls, (segments, margin))
+    return _solved(spec, problem, params, gname, ctrl_cls, (segments, margin), notify)
 
 
 def _solved(spec: PlannerSpec, problem: Problem, params: Any, gname: str | None,
             ctrl_cls: type[Controller] | None,
-            warm_first: tuple[bool, bool] | None = None) -> PlanResult:
+            warm_first: tuple[bool, bool] | None = None,
+            notify: Callable[[], None] | None = None) -> PlanResult:
     """:func:`solve` once its kernels are warm or run interpreted, or, with
-    ``warm_first`` (``segments`` and ``margin`` of :func:`warm`), after warming them (a
-    query that fails its checks warms nothing)."""
+    ``warm_first`` (``segments`` and ``margin`` of :func:`warm`), after warming them
+    (``notify`` as :func:`warm`'s; a query that fails its checks warms nothing)."""
     bad = problem.failure()
     if bad is not None:
         return PlanResult(bad[0], planner=spec.name, message=bad[1])
     if warm_first is not None:
-        warm(spec, params=params, segments=warm_first[0], margin=warm_first[1])
+        warm(spec, notify, params=params, segments=warm_first[0], margin=warm_first[1])
     budget = problem.budget
     if spec.function is not None:
         res = spec.function(problem.grid, np.array(problem.start), np.array(problem.goal),

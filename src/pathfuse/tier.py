@@ -4,7 +4,7 @@ numba compiles a kernel the first time a process calls it, or loads it from
 its on-disk cache.  On an empty cache that compile is most of a small plan:
 ``pathfuse plan --map paper --planner fusion`` compiles 28 functions for about
 13 s of CPU, then plans the 15 x 15 map in 0.07 ms; the same kernels run as
-plain Python plan it in about 3 ms.  So a plan on a small map whose kernels are
+plain Python plan it in about 6 ms.  So a plan on a small map whose kernels are
 not compiled yet runs them *interpreted*: the same Python source numba compiles
 (its ``py_func``), with every kernel it calls interpreted too (:func:`interpreted`)
 and numba's intrinsics replaced by Python functions registered beside them
@@ -33,9 +33,10 @@ into a kernel: the searches and the stepping loops are called in chunks while
 interpreted) starts again compiled.  The
 environment variable ``PATHFUSE_KERNELS`` sets the rule: ``auto``, ``compiled``
 (always compile: timings comparable with a warm cache) or ``interpreted``
-(never compile what this module covers: a debugger steps through the kernels'
-source).  A plan that ran interpreted says so in ``result.info["kernels"]``;
-its ``time_s`` is the interpreter's time.
+(every plan runs its kernels interpreted, whatever its map, budget or time limit,
+in a process that has not compiled them: a debugger steps through their source).
+A plan that ran interpreted says so in ``result.info["kernels"]``; its ``time_s``
+is the interpreter's time.
 
 This module is ours, not the paper's; it changes which machine code runs, never
 what is computed.
@@ -73,6 +74,7 @@ _ENV = "PATHFUSE_KERNELS"
 class OverBudget(Exception):
     """Raised inside a plan that runs interpreted when the process has spent
     :data:`BUDGET_S` interpreting (under ``auto``): the plan is run again compiled."""
+
 
 _state = {"on": True, "spent": 0.0}
 _NOW: contextvars.ContextVar[bool] = contextvars.ContextVar("pathfuse_interpreting",

@@ -28,6 +28,7 @@ Statuses (:class:`~pathfuse.result.Status`, the one vocabulary of pathfuse):
 
 from __future__ import annotations
 
+import contextvars
 import dataclasses
 import math
 import time
@@ -286,7 +287,8 @@ _WARM_SCENARIO: dict[str, Any] = {
     "obstacles": [{"position": [5.5, 2.5], "velocity": [-1.0, 0.0], "radius": 0.3}],
 }
 _WARM_EPISODES: set[Any] = set()
-_WARMING = [False]
+_WARMING: contextvars.ContextVar[bool] = contextvars.ContextVar("pathfuse_warm_episode",
+                                                               default=False)
 
 
 def _warm_episode(spec: Any, model: RobotModel, cfg: Any) -> None:
@@ -295,22 +297,23 @@ def _warm_episode(spec: Any, model: RobotModel, cfg: Any) -> None:
     thrown away.  pathfuse's own controllers only: a plug-in's controller is not made
     once more behind its author's back (its warm-up methods are its own)."""
     ctrl = spec.controller
-    if _WARMING[0] or ctrl is None or not ctrl.__module__.startswith("pathfuse."):
+    if _WARMING.get() or ctrl is None or not ctrl.__module__.startswith("pathfuse."):
         return
+    key: Any = (spec.name, repr(model.to_dict()), cfg)
     try:
-        key: Any = (spec.name, model.to_dict().__repr__(), hash(cfg), cfg)
+        hash(key)
     except TypeError:  # parameters that do not hash
-        key = (spec.name, model.to_dict().__repr__(), repr(cfg))
+        key = (spec.name, repr(model.to_dict()), repr(cfg))
     if key in _WARM_EPISODES:
         return
     robot = model.replace(radius_m=min(model.radius_m, 0.2), sensing_radius_m=3.0,
                           clearance_m=min(model.clearance_m, 0.05),
                           inflation_m=min(model.inflation_m, 0.2), heading_rad=None)
-    _WARMING[0] = True
+    token = _WARMING.set(True)
     try:
         run_episode(load_scenario(_WARM_SCENARIO), spec.name, cfg, seed=0, robot=robot)
     finally:
-        _WARMING[0] = False
+        _WARMING.reset(token)
     _WARM_EPISODES.add(key)
 
 

@@ -90,13 +90,12 @@ with open(sys.argv[1], "wb") as f:
 """
 
 
-def _fresh(tmp_path, script, mode="interpreted", args=()):
+def _fresh(tmp_path, script, mode="interpreted"):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PATHFUSE_KERNELS": mode}
     # interpreted, numpy's warnings are errors: its scalars warn (RuntimeWarning) where
     # compiled code is silent (an overflow, a division by zero), and a user would see them
     strict = ["-W", "error::RuntimeWarning"] if mode == "interpreted" else []
-    proc = subprocess.run([sys.executable, *strict, "-c", script, str(tmp_path / "out.pkl"),
-                           *args],
+    proc = subprocess.run([sys.executable, *strict, "-c", script, str(tmp_path / "out.pkl")],
                           capture_output=True, text=True, env=env, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     with open(tmp_path / "out.pkl", "rb") as f:
@@ -125,10 +124,9 @@ def test_every_planner_interpreted_gives_the_compiled_result_and_compiles_nothin
 
 
 AUTO = CASES + r"""
-import pickle, sys, time
+import pickle, sys
 import pathfuse
 from pathfuse import tier
-from pathfuse.generate import PAPER_GOAL, PAPER_START, paper_map, random_map
 
 out = []
 g = paper_map(0)
